@@ -1,0 +1,31 @@
+# Every dependency is a Debian 12 package (see scripts/bootstrap.sh and
+# ../shared/DEPENDENCIES.md). Nothing is downloaded at build time.
+find_package(PkgConfig REQUIRED)
+find_package(Threads REQUIRED)
+find_package(Eigen3 3.4 REQUIRED CONFIG)
+find_package(assimp 5.2 REQUIRED CONFIG)
+find_package(PNG REQUIRED)
+find_package(fmt REQUIRED CONFIG)
+find_package(CLI11 REQUIRED CONFIG)
+find_package(tomlplusplus REQUIRED CONFIG)  # target tomlplusplus::tomlplusplus
+# OSMesa only: linking libGL as well turns every GL call into a no-op.
+pkg_check_modules(OSMESA REQUIRED IMPORTED_TARGET osmesa)
+
+# CHOLMOD (SuiteSparse 5.12) ships neither a CMake config nor a .pc file.
+find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
+find_library(CHOLMOD_LIBRARY cholmod REQUIRED)
+find_library(SUITESPARSECONFIG_LIBRARY suitesparseconfig REQUIRED)
+if(NOT TARGET crumple::cholmod)
+  add_library(crumple_cholmod INTERFACE)
+  target_include_directories(crumple_cholmod SYSTEM INTERFACE ${CHOLMOD_INCLUDE_DIR})
+  target_link_libraries(crumple_cholmod INTERFACE ${CHOLMOD_LIBRARY} ${SUITESPARSECONFIG_LIBRARY})
+  add_library(crumple::cholmod ALIAS crumple_cholmod)
+endif()
+
+if(CRUMPLE_BUILD_TESTS)
+  find_package(GTest REQUIRED CONFIG)
+  include(GoogleTest)
+endif()
+if(CRUMPLE_BUILD_BENCH)
+  find_package(benchmark REQUIRED CONFIG)
+endif()

@@ -1,0 +1,115 @@
+#pragma once
+// The .pcache mesh cache (DESIGN.md "Cache format"): little-endian, chunked,
+// versioned. A header chunk, one chunk per frame (topology only when it
+// changed), each with a CRC32, and a footer with the frame offset table. A
+// reader that finds no footer (a crashed writer) recovers every complete
+// frame by scanning. Layout in docs/PCACHE.md.
+#include <array>
+#include <cstdint>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "crumple/core/types.hpp"
+
+namespace crumple::cache {
+
+inline constexpr std::uint32_t kFormatVersion = 1;
+
+struct CacheHeader {
+  std::uint32_t formatVersion = kFormatVersion;
+  double fps = 24.0;
+  int frameStart = 1;
+  int frameEnd = 1;  // planned last frame (inclusive); the file may hold fewer
+  int substeps = 1;
+  std::uint64_t seed = 0;
+  std::string sceneName;
+  std::string sceneFile;   // path of the scene file the shot came from
+  std::string sceneText;   // the scene file's text (renderers re-parse it)
+  double sheetWidth = 0.0;   // m (0 for a pattern mesh)
+  double sheetHeight = 0.0;  // m
+  std::string paperName;
+  double paperThickness = 0.0;  // m
+  std::vector<std::string> handleNames;
+};
+
+struct CameraRecord {
+  Vec3 position = Vec3::Zero();
+  Quat rotation = Quat::Identity();  // looks down local -Z, +Y up
+  double yfov = 0.0;                 // rad
+};
+
+struct FrameRecord {
+  int frame = 0;
+  double time = 0.0;  // s
+  // Topology (written only when it differs from the previous frame's).
+  std::vector<std::array<int, 3>> triangles;
+  std::vector<int> regionOfTriangle;
+  std::vector<std::uint8_t> regionTypes;  // mesh::RegionType per region id
+  std::vector<Vec2> pattern;              // m
+  // Geometry.
+  std::vector<Vec3> positions;  // m
+  // Model structure (empty until the crumpling model fills them).
+  std::vector<int> singularVertices;
+  std::vector<int> junctionVertices;
+  std::vector<std::array<int, 2>> rulings;
+  std::uint32_t tearCount = 0;
+  // Handles, in header.handleNames order: the constrained vertex and the
+  // imported track's position at this frame's time.
+  std::vector<int> handleVertices;
+  std::vector<Vec3> handleTargets;
+  CameraRecord camera;
+};
+
+// Writes a cache. Frames are appended in order; close() writes the footer.
+// A writer destroyed without close() leaves a footer-less file that
+// CacheReader recovers.
+class CacheWriter {
+ public:
+  // Throws InputError if the file cannot be created.
+  CacheWriter(const std::string& path, const CacheHeader& header);
+  ~CacheWriter();
+  CacheWriter(const CacheWriter&) = delete;
+  CacheWriter& operator=(const CacheWriter&) = delete;
+  void append(const FrameRecord& frame);
+  void close();
+  std::size_t framesWritten() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// A problem found while reading: which frame (or -1 for header/footer).
+struct CacheIssue {
+  int frameIndex = -1;
+  std::string message;
+};
+
+class CacheReader {
+ public:
+  // Opens and indexes a cache: uses the footer when it is intact, otherwise
+  // scans and keeps every complete, CRC-valid frame before the first bad one
+  // (recovered() is then true). Throws InputError for a missing file or a
+  // damaged header, CorruptDataError never here.
+  explicit CacheReader(const std::string& path);
+  ~CacheReader();
+  CacheReader(CacheReader&&) noexcept;
+  CacheReader& operator=(CacheReader&&) noexcept;
+
+  const CacheHeader& header() const;
+  std::size_t frameCount() const;
+  bool recovered() const;
+  // Issues found while opening (missing footer, truncated block, CRC mismatch).
+  const std::vector<CacheIssue>& issues() const;
+  // Full frame (topology carried forward from earlier frames). Throws
+  // CorruptDataError naming the frame number when its CRC does not match.
+  FrameRecord readFrame(std::size_t index) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace crumple::cache

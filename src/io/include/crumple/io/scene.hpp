@@ -1,0 +1,134 @@
+#pragma once
+// The scene file (scene.toml, parsed with toml++): what one shot is.
+// All lengths are converted to metres on parse (scene `units`), angles to
+// radians. Unknown keys and bad values throw crumple::InputError naming the
+// file, the line and the key (DESIGN.md "Invariants").
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "crumple/core/types.hpp"
+
+namespace crumple::io {
+
+// A paper material preset (assets/papers/*.toml). Raw physical numbers; the
+// simulator derives stretch and bending stiffness from them.
+struct PaperPreset {
+  std::string name;            // e.g. "office-70gsm"
+  std::string file;            // where it was read from
+  double grammage = 0.0;       // kg/m^2
+  double thickness = 0.0;      // m
+  double density = 0.0;        // kg/m^3 (grammage / thickness)
+  double youngsModulus = 0.0;  // Pa
+  double poissonRatio = 0.0;
+  Vec3 frontColor{0.92, 0.92, 0.90};  // linear RGB albedo of the printed side
+  Vec3 backColor{0.92, 0.92, 0.90};
+};
+
+struct SheetSpec {
+  enum class Kind { Rectangle, PatternMesh };
+  Kind kind = Kind::Rectangle;
+  double width = 0.0;   // m (Rectangle)
+  double height = 0.0;  // m (Rectangle)
+  std::string patternMesh;  // mesh node name in the animation file (PatternMesh)
+  double maxEdge = 0.0;     // m: simulation mesh resolution; 0 = min(width, height) / 16
+  // Placement of the pattern in the world: x = origin + u * uAxis + v * vAxis.
+  Vec3 origin = Vec3::Zero();
+  Vec3 uAxis = Vec3::UnitX();
+  Vec3 vAxis = -Vec3::UnitZ();  // default: lying flat, front side facing +Y (up)
+};
+
+struct HandleSpec {
+  std::string name;                  // unique handle name (defaults to node)
+  std::string node;                  // animated node in the animation file
+  std::optional<Vec2> patternPoint;  // m; nullopt = sheet point nearest the node at the first frame
+  // Tangent-plane control (thesis 2.3.1): the node's rotation drives 2-4
+  // neighbour vertices. tangentVertices 0 = automatic (2 at a corner, 3 on a
+  // border, 4 inside).
+  bool tangentControl = false;
+  int tangentVertices = 0;
+  std::optional<double> releaseTime;  // s: the handle lets go at this time
+};
+
+struct CameraSpec {
+  // Either a camera node of the animation file or a fixed camera from the scene.
+  std::string node;  // non-empty = take the camera from this animation node
+  Vec3 position{0.0, 0.3, 0.6};
+  Vec3 lookAt = Vec3::Zero();
+  Vec3 up = Vec3::UnitY();
+  double yfov = 0.6981317007977318;  // rad (40 degrees); focal_mm + sensor_mm override it
+  int width = 640;
+  int height = 480;
+};
+
+struct LightSpec {
+  enum class Kind { Directional, Point };
+  std::string name;
+  Kind kind = Kind::Directional;
+  Vec3 direction{-0.4, -1.0, -0.3};  // Directional: direction the light travels
+  Vec3 position = Vec3::Zero();      // Point
+  Vec3 color{1.0, 1.0, 1.0};
+  double intensity = 1.0;
+  bool shadow = false;  // the key light casts the paper's shadow
+};
+
+struct GroundSpec {
+  bool enabled = false;
+  double height = 0.0;  // m, world Y of the plane
+  double size = 2.0;    // m, side of the square drawn
+  Vec3 color{0.55, 0.50, 0.45};
+};
+
+struct OutputSpec {
+  std::string dir;  // empty = out/<scene name>/ relative to the working directory
+  bool frames = true;
+};
+
+struct SimSpec {
+  Vec3 gravity{0.0, -9.81, 0.0};  // m/s^2, world is Y-up
+  double massDamping = 0.5;       // 1/s, Rayleigh alpha
+  double stiffnessDamping = 0.0;  // s, Rayleigh beta
+  int maxNewtonIterations = 30;
+};
+
+struct SceneSpec {
+  std::string file;  // scene.toml path as given
+  std::string dir;   // folder holding it (relative paths resolve here)
+  std::string name;  // [scene] name, default: folder name
+  std::string animationFile;  // resolved path, may be empty (no handles then)
+  double metresPerUnit = 1.0;
+  double fps = 24.0;
+  int frameStart = 1;
+  int frameEnd = 48;  // inclusive
+  int substeps = 4;
+  std::uint64_t seed = 1;
+  SheetSpec sheet;
+  std::string paperPreset = "office-70gsm";
+  PaperPreset paper;  // resolved preset
+  std::vector<HandleSpec> handles;
+  CameraSpec camera;
+  std::vector<LightSpec> lights;  // default: a key (with shadow) and a fill
+  GroundSpec ground;
+  OutputSpec output;
+  SimSpec sim;
+  std::string sourceText;  // the scene file's text, kept for the cache header
+};
+
+// Parse a scene file. Resolves the paper preset (see paperPresetDirs) and the
+// animation file path; does not load the animation.
+SceneSpec loadScene(const std::string& path);
+// Parse scene text; sourceName names it in errors, baseDir resolves paths.
+SceneSpec parseScene(std::string_view text, const std::string& sourceName,
+                     const std::string& baseDir);
+// SCENE may be a scene.toml or a folder holding one.
+std::string resolveScenePath(const std::string& sceneOrFolder);
+
+// Load one preset file; errors name the file, line and key.
+PaperPreset loadPaperPreset(const std::string& path);
+// Directories searched for "<preset>.toml": $CRUMPLE_ASSETS/papers, then the
+// source tree's assets/papers (compiled in as CRUMPLE_SOURCE_ASSETS).
+std::vector<std::string> paperPresetDirs();
+
+}  // namespace crumple::io

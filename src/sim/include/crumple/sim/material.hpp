@@ -1,0 +1,27 @@
+#pragma once
+// Paper as a thin elastic plate: stretch and bending stiffness from thickness,
+// Young's modulus and Poisson ratio (Kirchhoff-Love plate theory).
+#include <string>
+
+namespace crumple::sim {
+
+struct Material {
+  std::string name;
+  double thickness = 1.0e-4;      // m
+  double density = 700.0;         // kg/m^3
+  double youngsModulus = 4.0e9;   // Pa
+  double poissonRatio = 0.3;
+
+  double arealDensity() const { return density * thickness; }  // kg/m^2
+  // Membrane (stretch) stiffness E h / (1 - nu^2), N/m.
+  double stretchStiffness() const {
+    return youngsModulus * thickness / (1.0 - poissonRatio * poissonRatio);
+  }
+  // Flexural rigidity E h^3 / (12 (1 - nu^2)), N m.
+  double bendingStiffness() const {
+    return youngsModulus * thickness * thickness * thickness /
+           (12.0 * (1.0 - poissonRatio * poissonRatio));
+  }
+};
+
+}  // namespace crumple::sim
