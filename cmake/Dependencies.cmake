@@ -5,7 +5,6 @@ find_package(Threads REQUIRED)
 find_package(Eigen3 3.4 REQUIRED CONFIG)
 find_package(assimp 5.2 REQUIRED CONFIG)
 find_package(PNG REQUIRED)
-find_package(fmt REQUIRED CONFIG)
 find_package(CLI11 REQUIRED CONFIG)
 find_package(tomlplusplus REQUIRED CONFIG)  # target tomlplusplus::tomlplusplus
 # OSMesa only: linking libGL as well turns every GL call into a no-op.

@@ -1,0 +1,55 @@
+#pragma once
+// Handles: each binds an animated node to a vertex of the sheet, optionally
+// with tangent-plane control where the node's rotation drives 2-4 neighbour
+// vertices (paper Sec. 4, thesis 2.3.1).
+#include <string>
+#include <vector>
+
+#include "crumple/core/types.hpp"
+#include "crumple/io/animation.hpp"
+#include "crumple/io/scene.hpp"
+#include "crumple/mesh/sheet_mesh.hpp"
+#include "crumple/sim/elastic_sheet.hpp"
+
+namespace crumple::pipeline {
+
+struct BoundHandle {
+  std::string name;
+  std::string node;
+  int vertex = -1;
+  // Tangent-plane control: neighbour vertices and their offsets from the
+  // handle vertex in the node's frame at bind time.
+  std::vector<int> tangentVertices;
+  std::vector<Vec3> tangentOffsets;
+  Quat bindRotation = Quat::Identity();
+  double releaseTime = 0.0;
+  bool releases = false;
+};
+
+class HandleRig {
+ public:
+  // Binds every handle of the scene to the sheet at time t0 (the first frame).
+  // Throws InputError (naming the scene file and handle) for a node the
+  // animation does not have, or two handles on one vertex.
+  HandleRig(const io::SceneSpec& scene, const io::AnimationScene* animation,
+            const mesh::SheetMesh& sheet, double t0);
+
+  const std::vector<BoundHandle>& handles() const { return handles_; }
+  // Position of the handle's node at time t (world, metres).
+  Vec3 target(std::size_t handle, double t) const;
+  // Every pinned vertex and where it must be at time t.
+  void pins(double t, std::vector<sim::Pin>& out) const;
+  // Moves pinned vertices onto their targets (called once before simulation).
+  void snap(double t, std::vector<Vec3>& positions) const;
+
+ private:
+  const io::AnimationScene* animation_;
+  std::vector<BoundHandle> handles_;
+};
+
+// Neighbour vertices that define the tangent plane at `vertex` (thesis 2.3.1):
+// 2 at a corner of the pattern, 3 on its border, 4 inside; `count` > 0 forces
+// the number. Chosen among the one-ring by pattern direction, deterministic.
+std::vector<int> tangentNeighbours(const mesh::SheetMesh& sheet, int vertex, int count);
+
+}  // namespace crumple::pipeline

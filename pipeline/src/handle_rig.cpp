@@ -1,0 +1,149 @@
+#include "crumple/pipeline/handle_rig.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+
+#include "crumple/core/error.hpp"
+
+namespace crumple::pipeline {
+namespace {
+
+// Boundary vertices of the pattern: those on an edge with one triangle.
+std::vector<bool> boundaryVertices(const mesh::SheetMesh& sheet) {
+  std::vector<bool> onBoundary(sheet.vertexCount(), false);
+  for (const auto& e : mesh::buildEdges(sheet))
+    if (!e.interior()) onBoundary[static_cast<std::size_t>(e.v[0])] = onBoundary[static_cast<std::size_t>(e.v[1])] = true;
+  return onBoundary;
+}
+
+}  // namespace
+
+std::vector<int> tangentNeighbours(const mesh::SheetMesh& sheet, int vertex, int count) {
+  const auto ring = mesh::vertexNeighbours(sheet, vertex);
+  const auto onBoundary = boundaryVertices(sheet);
+  const Vec2 p = sheet.pattern[static_cast<std::size_t>(vertex)];
+  if (count <= 0) {
+    int boundaryNeighbours = 0;
+    for (int n : ring) boundaryNeighbours += onBoundary[static_cast<std::size_t>(n)] ? 1 : 0;
+    if (!onBoundary[static_cast<std::size_t>(vertex)]) {
+      count = 4;
+    } else {
+      // A corner's one-ring spans less than pi in the pattern; a border's spans pi.
+      double minAngle = 10.0, maxAngle = -10.0;
+      const Vec2 c = [&] {
+        Vec2 s = Vec2::Zero();
+        for (int n : ring) s += (sheet.pattern[static_cast<std::size_t>(n)] - p).normalized();
+        return s.normalized().eval();
+      }();
+      for (int n : ring) {
+        const Vec2 d = (sheet.pattern[static_cast<std::size_t>(n)] - p).normalized();
+        const double a = std::atan2(c.x() * d.y() - c.y() * d.x(), c.dot(d));
+        minAngle = std::min(minAngle, a);
+        maxAngle = std::max(maxAngle, a);
+      }
+      count = (maxAngle - minAngle) < 0.75 * std::numbers::pi ? 2 : 3;
+    }
+  }
+  count = std::clamp(count, 2, 4);
+  count = std::min<int>(count, static_cast<int>(ring.size()));
+  // Greedy farthest-direction selection: start with the neighbour of largest
+  // distance (lowest index on ties), then repeatedly add the one whose
+  // direction is angularly farthest from those chosen.
+  std::vector<int> chosen;
+  std::vector<Vec2> dirs;
+  for (int n : ring) dirs.push_back((sheet.pattern[static_cast<std::size_t>(n)] - p).normalized());
+  std::size_t first = 0;
+  for (std::size_t i = 1; i < ring.size(); ++i) {
+    const bool iBoundary = onBoundary[static_cast<std::size_t>(ring[i])];
+    const bool fBoundary = onBoundary[static_cast<std::size_t>(ring[first])];
+    if (iBoundary && !fBoundary) first = i;
+  }
+  std::vector<bool> taken(ring.size(), false);
+  taken[first] = true;
+  chosen.push_back(ring[first]);
+  while (static_cast<int>(chosen.size()) < count) {
+    std::size_t best = ring.size();
+    double bestScore = -1.0;
+    for (std::size_t i = 0; i < ring.size(); ++i) {
+      if (taken[i]) continue;
+      double minAngle = 10.0;
+      for (std::size_t j = 0; j < ring.size(); ++j)
+        if (taken[j]) minAngle = std::min(minAngle, std::acos(std::clamp(dirs[i].dot(dirs[j]), -1.0, 1.0)));
+      if (minAngle > bestScore + 1e-12) {
+        bestScore = minAngle;
+        best = i;
+      }
+    }
+    taken[best] = true;
+    chosen.push_back(ring[best]);
+  }
+  std::sort(chosen.begin(), chosen.end());
+  return chosen;
+}
+
+HandleRig::HandleRig(const io::SceneSpec& scene, const io::AnimationScene* animation,
+                     const mesh::SheetMesh& sheet, double t0)
+    : animation_(animation) {
+  std::map<int, std::string> usedVertices;
+  for (const auto& spec : scene.handles) {
+    if (animation == nullptr)
+      throw InputError(scene.file, "handle '" + spec.name + "' needs an animation file ([scene] animation)");
+    if (!animation->hasNode(spec.node))
+      throw InputError(scene.file, "handle '" + spec.name + "': node '" + spec.node +
+                                       "' does not exist in " + animation->file());
+    BoundHandle h;
+    h.name = spec.name;
+    h.node = spec.node;
+    const Pose pose = animation->worldPose(spec.node, t0);
+    h.vertex = spec.patternPoint ? mesh::nearestPatternVertex(sheet, *spec.patternPoint)
+                                 : mesh::nearestVertex(sheet, pose.position);
+    if (auto [it, inserted] = usedVertices.emplace(h.vertex, h.name); !inserted)
+      throw InputError(scene.file, "handles '" + it->second + "' and '" + h.name +
+                                       "' bind the same sheet vertex " + std::to_string(h.vertex));
+    if (spec.releaseTime) {
+      h.releases = true;
+      h.releaseTime = *spec.releaseTime;
+    }
+    if (spec.tangentControl) {
+      h.tangentVertices = tangentNeighbours(sheet, h.vertex, spec.tangentVertices);
+      h.bindRotation = pose.rotation;
+      const Vec3 base = sheet.positions[static_cast<std::size_t>(h.vertex)];
+      for (int n : h.tangentVertices) {
+        if (usedVertices.count(n) != 0)
+          throw InputError(scene.file, "handle '" + h.name + "': tangent-plane vertex " +
+                                           std::to_string(n) + " is already held by handle '" +
+                                           usedVertices[n] + "'");
+        // Offset expressed in the node's frame at bind time.
+        h.tangentOffsets.push_back(pose.rotation.conjugate() *
+                                   (sheet.positions[static_cast<std::size_t>(n)] - base));
+      }
+      for (int n : h.tangentVertices) usedVertices.emplace(n, h.name);
+    }
+    handles_.push_back(std::move(h));
+  }
+}
+
+Vec3 HandleRig::target(std::size_t handle, double t) const {
+  return animation_->worldPose(handles_[handle].node, t).position;
+}
+
+void HandleRig::pins(double t, std::vector<sim::Pin>& out) const {
+  out.clear();
+  for (const auto& h : handles_) {
+    if (h.releases && t >= h.releaseTime) continue;
+    const Pose pose = animation_->worldPose(h.node, t);
+    out.push_back({h.vertex, pose.position});
+    for (std::size_t k = 0; k < h.tangentVertices.size(); ++k)
+      out.push_back({h.tangentVertices[k], pose.position + pose.rotation * h.tangentOffsets[k]});
+  }
+}
+
+void HandleRig::snap(double t, std::vector<Vec3>& positions) const {
+  std::vector<sim::Pin> p;
+  pins(t, p);
+  for (const auto& pin : p) positions[static_cast<std::size_t>(pin.vertex)] = pin.position;
+}
+
+}  // namespace crumple::pipeline

@@ -1,0 +1,111 @@
+#include "crumple/pipeline/inspect.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <set>
+#include <utility>
+
+#include "json_writer.hpp"
+
+namespace crumple::pipeline {
+
+FrameMetrics measureFrame(const cache::FrameRecord& frame) {
+  FrameMetrics m;
+  m.frame = frame.frame;
+  m.time = frame.time;
+  m.vertices = frame.positions.size();
+  m.triangles = frame.triangles.size();
+  std::set<std::pair<int, int>> edges;
+  for (const auto& t : frame.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[static_cast<std::size_t>(k)], b = t[static_cast<std::size_t>((k + 1) % 3)];
+      edges.emplace(std::min(a, b), std::max(a, b));
+    }
+  double sum = 0.0;
+  std::size_t compressed = 0;
+  for (const auto& [a, b] : edges) {
+    const double rest = (frame.pattern[static_cast<std::size_t>(a)] - frame.pattern[static_cast<std::size_t>(b)]).norm();
+    const double now = (frame.positions[static_cast<std::size_t>(a)] - frame.positions[static_cast<std::size_t>(b)]).norm();
+    const double strain = (now - rest) / rest;
+    sum += std::abs(strain);
+    m.maxStrain = std::max(m.maxStrain, std::abs(strain));
+    if (strain < -0.01) ++compressed;
+  }
+  if (!edges.empty()) {
+    m.cMean = sum / static_cast<double>(edges.size());
+    m.nComp = static_cast<double>(compressed) / static_cast<double>(edges.size());
+  }
+  for (std::size_t h = 0; h < frame.handleVertices.size(); ++h) {
+    const int v = frame.handleVertices[h];
+    if (v < 0) continue;  // released
+    m.handleError = std::max(m.handleError, (frame.positions[static_cast<std::size_t>(v)] - frame.handleTargets[h]).norm());
+  }
+  m.singularVertices = frame.singularVertices.size();
+  m.junctionVertices = frame.junctionVertices.size();
+  m.tears = frame.tearCount;
+  return m;
+}
+
+std::string inspectJson(const cache::CacheReader& reader) {
+  const auto& header = reader.header();
+  JsonWriter j;
+  j.beginObject();
+  j.key("format_version").value(static_cast<long long>(header.formatVersion));
+  j.key("fps").value(header.fps);
+  j.key("frame_count").value(reader.frameCount());
+  j.key("frames").beginArray();
+  for (std::size_t i = 0; i < reader.frameCount(); ++i) {
+    const auto frame = reader.readFrame(i);
+    const auto m = measureFrame(frame);
+    j.beginObject();
+    j.key("frame").value(m.frame);
+    j.key("time").value(m.time);
+    j.key("vertices").value(m.vertices);
+    j.key("triangles").value(m.triangles);
+    j.key("c_mean").value(m.cMean);
+    j.key("n_comp").value(m.nComp);
+    j.key("max_strain").value(m.maxStrain);
+    j.key("handle_error").value(m.handleError);
+    j.key("handles").beginArray();
+    for (std::size_t h = 0; h < frame.handleTargets.size(); ++h) {
+      j.beginObject();
+      j.key("name").value(h < header.handleNames.size() ? header.handleNames[h] : std::string());
+      const int v = frame.handleVertices[h];
+      const Vec3 p = v >= 0 ? frame.positions[static_cast<std::size_t>(v)] : frame.handleTargets[h];
+      j.key("position").beginArray().value(p.x()).value(p.y()).value(p.z()).endArray();
+      j.endObject();
+    }
+    j.endArray();
+    j.key("singular_vertices").value(m.singularVertices);
+    j.key("junction_vertices").value(m.junctionVertices);
+    j.key("tears").value(m.tears);
+    j.endObject();
+  }
+  j.endArray();
+  j.endObject();
+  return j.str() + "\n";
+}
+
+std::string inspectText(const cache::CacheReader& reader) {
+  const auto& header = reader.header();
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line, "scene %s, format %u, %.6g fps, %zu frames%s\n",
+                header.sceneName.c_str(), header.formatVersion, header.fps, reader.frameCount(),
+                reader.recovered() ? " (recovered: no valid footer)" : "");
+  out += line;
+  for (const auto& issue : reader.issues()) out += "  note: " + issue.message + "\n";
+  std::snprintf(line, sizeof line, "%6s %9s %8s %9s %10s %8s %10s %12s\n", "frame", "time[s]",
+                "verts", "tris", "c_mean", "n_comp", "max_strain", "handle_err[m]");
+  out += line;
+  for (std::size_t i = 0; i < reader.frameCount(); ++i) {
+    const auto m = measureFrame(reader.readFrame(i));
+    std::snprintf(line, sizeof line, "%6d %9.4f %8zu %9zu %10.3e %8.4f %10.3e %12.3e\n", m.frame,
+                  m.time, m.vertices, m.triangles, m.cMean, m.nComp, m.maxStrain, m.handleError);
+    out += line;
+  }
+  return out;
+}
+
+}  // namespace crumple::pipeline

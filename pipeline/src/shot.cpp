@@ -1,0 +1,477 @@
+#include "crumple/pipeline/shot.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <regex>
+
+#include <Eigen/Eigenvalues>
+
+#include "crumple/core/error.hpp"
+#include "crumple/core/progress.hpp"
+#include "crumple/exporters/png.hpp"
+#include "crumple/pipeline/handle_rig.hpp"
+#include "crumple/pipeline/inspect.hpp"
+#include "crumple/render/osmesa_renderer.hpp"
+#include "crumple/sim/elastic_sheet.hpp"
+#include "json_writer.hpp"
+
+namespace crumple::pipeline {
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// Time of a frame: the scene's first frame is t = 0 s (DCC frame f at (f - first) / fps).
+double frameTime(const io::SceneSpec& scene, int frame) {
+  return static_cast<double>(frame - scene.frameStart) / scene.fps;
+}
+
+std::string frameFileName(int frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%04d.png", frame);
+  return name;
+}
+
+// Creates the folder and checks that a file can be written in it.
+void prepareOutputDir(const std::string& dir, const std::string& what) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw InputError(dir, "cannot create the " + what + " folder: " + ec.message());
+  const fs::path probe = fs::path(dir) / ".crumple-write-probe";
+  {
+    std::ofstream out(probe);
+    if (!out) throw InputError(dir, "the " + what + " folder is not writable");
+  }
+  fs::remove(probe, ec);
+}
+
+sim::Material materialOf(const io::PaperPreset& paper) {
+  sim::Material m;
+  m.name = paper.name;
+  m.thickness = paper.thickness;
+  m.density = paper.density;
+  m.youngsModulus = paper.youngsModulus;
+  m.poissonRatio = paper.poissonRatio;
+  return m;
+}
+
+cache::CameraRecord cameraAt(const io::SceneSpec& scene, const io::AnimationScene* animation,
+                             double t) {
+  cache::CameraRecord rec;
+  if (!scene.camera.node.empty() && animation != nullptr) {
+    const auto cam = animation->camera(scene.camera.node, t);
+    if (!cam)
+      throw InputError(scene.file, "[camera] node '" + scene.camera.node + "' has no camera in " +
+                                       animation->file());
+    rec.position = cam->position;
+    rec.rotation = cam->rotation;
+    rec.yfov = cam->yfov > 0.0 ? cam->yfov : scene.camera.yfov;
+    return rec;
+  }
+  const auto c = render::Camera::lookAt(scene.camera.position, scene.camera.lookAt,
+                                        scene.camera.up, scene.camera.yfov, scene.camera.width,
+                                        scene.camera.height);
+  rec.position = c.position;
+  rec.rotation = c.rotation;
+  rec.yfov = c.yfov;
+  return rec;
+}
+
+mesh::SheetMesh sheetOfFrame(const cache::FrameRecord& frame) {
+  mesh::SheetMesh m;
+  m.pattern = frame.pattern;
+  m.positions = frame.positions;
+  m.triangles = frame.triangles;
+  m.regionOfTriangle = frame.regionOfTriangle;
+  for (auto t : frame.regionTypes) m.regionTypes.push_back(static_cast<mesh::RegionType>(t));
+  return m;
+}
+
+// Renders cached frames with one OSMesa context, reused across frames.
+class FrameRenderer {
+ public:
+  FrameRenderer(const io::SceneSpec& scene, std::string framesDir)
+      : scene_(scene),
+        framesDir_(std::move(framesDir)),
+        renderer_(scene.camera.width, scene.camera.height),
+        texture_(render::makeRuledPaperTexture(512, 512)) {}
+
+  void render(const cache::FrameRecord& frame) {
+    auto view = makeRenderScene(scene_, frame.camera);
+    view.paper.texture = texture_;
+    // Texture spans the pattern's bounding box.
+    Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const auto& p : frame.pattern) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    view.paper.textureSize = (hi - lo).cwiseMax(Vec2::Constant(1e-6));
+    const auto image = renderer_.render(view, sheetOfFrame(frame));
+    exporters::writePng((fs::path(framesDir_) / frameFileName(frame.frame)).string(), image);
+  }
+
+ private:
+  const io::SceneSpec& scene_;
+  std::string framesDir_;
+  render::OsmesaRenderer renderer_;
+  ImageRGBA8 texture_;
+};
+
+void validateRange(const io::SceneSpec& scene, const FrameRange& range) {
+  if (range.first < scene.frameStart || range.last > scene.frameEnd)
+    throw InputError(scene.file, "--frames " + std::to_string(range.first) + "-" +
+                                     std::to_string(range.last) + " is outside the scene's frames " +
+                                     std::to_string(scene.frameStart) + "-" +
+                                     std::to_string(scene.frameEnd));
+}
+
+void writeTextAtomically(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw InputError(path, "cannot write");
+    out << text;
+    if (!out) throw InputError(path, "cannot write");
+  }
+  fs::rename(tmp, path);
+}
+
+}  // namespace
+
+FrameRange parseFrameRange(const std::string& text) {
+  static const std::regex pattern(R"(^\s*(-?\d+)\s*(?:-\s*(-?\d+))?\s*$)");
+  std::smatch m;
+  if (!std::regex_match(text, m, pattern))
+    throw InputError("--frames", "expected A-B or A, got '" + text + "'");
+  FrameRange r;
+  r.first = std::stoi(m[1].str());
+  r.last = m[2].matched ? std::stoi(m[2].str()) : r.first;
+  if (r.last < r.first) throw InputError("--frames", "range " + text + " ends before it starts");
+  return r;
+}
+
+mesh::SheetMesh buildSheet(const io::SceneSpec& scene, const io::AnimationScene* animation) {
+  const auto& s = scene.sheet;
+  if (s.kind == io::SheetSpec::Kind::Rectangle) {
+    const double maxEdge = s.maxEdge > 0.0 ? s.maxEdge : std::min(s.width, s.height) / 16.0;
+    auto sheet = mesh::makeRectangleSheet(s.width, s.height, maxEdge);
+    mesh::placePattern(sheet, s.origin, s.uAxis.normalized(), s.vAxis.normalized());
+    return sheet;
+  }
+  // A flat pattern mesh from the animation file: its plane gives the pattern.
+  if (animation == nullptr)
+    throw InputError(scene.file, "[sheet] pattern_mesh needs an animation file");
+  const auto imported = animation->mesh(s.patternMesh);
+  if (!imported || imported->triangles.empty())
+    throw InputError(scene.file, "[sheet] pattern_mesh '" + s.patternMesh +
+                                     "' is not a mesh node of " + animation->file());
+  Vec3 centre = Vec3::Zero();
+  for (const auto& v : imported->vertices) centre += v;
+  centre /= static_cast<double>(imported->vertices.size());
+  Mat3 cov = Mat3::Zero();
+  for (const auto& v : imported->vertices) cov += (v - centre) * (v - centre).transpose();
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(cov);
+  const Vec3 normal = eig.eigenvectors().col(0);
+  Vec3 u = eig.eigenvectors().col(2);
+  Vec3 v = normal.cross(u);
+  double extent = 0.0, deviation = 0.0;
+  mesh::SheetMesh sheet;
+  for (const auto& p : imported->vertices) {
+    sheet.pattern.emplace_back((p - centre).dot(u), (p - centre).dot(v));
+    sheet.positions.push_back(p);
+    extent = std::max(extent, (p - centre).norm());
+    deviation = std::max(deviation, std::abs((p - centre).dot(normal)));
+  }
+  if (deviation > 1e-4 * std::max(extent, 1e-9))
+    throw InputError(scene.file, "[sheet] pattern_mesh '" + s.patternMesh +
+                                     "' is not flat (deviates " + std::to_string(deviation) +
+                                     " m from its plane)");
+  Vec2 lo = sheet.pattern.front();
+  for (const auto& p : sheet.pattern) lo = lo.cwiseMin(p);
+  for (auto& p : sheet.pattern) p -= lo;
+  for (auto t : imported->triangles) {
+    // Orient every triangle counter-clockwise in the pattern.
+    const Vec2 e1 = sheet.pattern[static_cast<std::size_t>(t[1])] - sheet.pattern[static_cast<std::size_t>(t[0])];
+    const Vec2 e2 = sheet.pattern[static_cast<std::size_t>(t[2])] - sheet.pattern[static_cast<std::size_t>(t[0])];
+    if (e1.x() * e2.y() - e1.y() * e2.x() < 0.0) std::swap(t[1], t[2]);
+    sheet.triangles.push_back(t);
+  }
+  sheet.regionOfTriangle.assign(sheet.triangles.size(), 0);
+  sheet.regionTypes = {mesh::RegionType::Flat};
+  if (const auto problem = mesh::validate(sheet); !problem.empty())
+    throw InputError(scene.file, "[sheet] pattern_mesh '" + s.patternMesh + "': " + problem);
+  return sheet;
+}
+
+render::RenderScene makeRenderScene(const io::SceneSpec& scene, const cache::CameraRecord& camera) {
+  render::RenderScene view;
+  view.camera.position = camera.position;
+  view.camera.rotation = camera.rotation;
+  view.camera.yfov = camera.yfov > 0.0 ? camera.yfov : scene.camera.yfov;
+  view.camera.width = scene.camera.width;
+  view.camera.height = scene.camera.height;
+  for (const auto& l : scene.lights) {
+    render::Light light;
+    light.kind = l.kind == io::LightSpec::Kind::Directional ? render::Light::Kind::Directional
+                                                            : render::Light::Kind::Point;
+    light.direction = l.direction;
+    light.position = l.position;
+    light.color = l.color;
+    light.intensity = l.intensity;
+    light.shadow = l.shadow;
+    view.lights.push_back(light);
+  }
+  view.ground.enabled = scene.ground.enabled;
+  view.ground.height = scene.ground.height;
+  view.ground.size = scene.ground.size;
+  view.ground.color = scene.ground.color;
+  view.paper.frontColor = scene.paper.frontColor;
+  view.paper.backColor = scene.paper.backColor;
+  return view;
+}
+
+ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
+  ShotReport report;
+  report.outDir = !options.outDir.empty()    ? options.outDir
+                  : !scene.output.dir.empty() ? scene.output.dir
+                                              : (fs::path("out") / scene.name).string();
+  FrameRange range{scene.frameStart, scene.frameEnd};
+  if (options.frames) {
+    validateRange(scene, *options.frames);
+    range = *options.frames;
+  }
+  const bool render = options.render && scene.output.frames;
+
+  // Everything that can be wrong with the input is checked before any output
+  // is written: no partial cache or frames that look valid.
+  std::unique_ptr<io::AnimationScene> animation;
+  if (!scene.animationFile.empty())
+    animation = std::make_unique<io::AnimationScene>(io::AnimationScene::load(scene.animationFile));
+  mesh::SheetMesh sheet = buildSheet(scene, animation.get());
+  const double t0 = frameTime(scene, scene.frameStart);
+  const HandleRig rig(scene, animation.get(), sheet, t0);
+  rig.snap(t0, sheet.positions);
+  for (int f = scene.frameStart; f <= range.last; ++f) (void)cameraAt(scene, animation.get(), frameTime(scene, f));
+  prepareOutputDir(report.outDir, "output");
+  report.cachePath = (fs::path(report.outDir) / "cache.pcache").string();
+  report.summaryPath = (fs::path(report.outDir) / "summary.json").string();
+  std::unique_ptr<FrameRenderer> renderer;
+  if (render) {
+    report.framesDir = (fs::path(report.outDir) / "frames").string();
+    prepareOutputDir(report.framesDir, "frames");
+    renderer = std::make_unique<FrameRenderer>(scene, report.framesDir);
+  }
+
+  sim::SimParams params;
+  params.gravity = scene.sim.gravity;
+  params.massDamping = scene.sim.massDamping;
+  params.stiffnessDamping = scene.sim.stiffnessDamping;
+  params.maxNewtonIterations = scene.sim.maxNewtonIterations;
+  sim::ElasticSheet elastic(sheet, materialOf(scene.paper), params);
+
+  cache::CacheHeader header;
+  header.fps = scene.fps;
+  header.frameStart = scene.frameStart;
+  header.frameEnd = range.last;
+  header.substeps = scene.substeps;
+  header.seed = options.seed.value_or(scene.seed);
+  header.sceneName = scene.name;
+  header.sceneFile = scene.file;
+  header.sceneText = scene.sourceText;
+  header.sheetWidth = scene.sheet.kind == io::SheetSpec::Kind::Rectangle ? scene.sheet.width : 0.0;
+  header.sheetHeight = scene.sheet.kind == io::SheetSpec::Kind::Rectangle ? scene.sheet.height : 0.0;
+  header.paperName = scene.paper.name;
+  header.paperThickness = scene.paper.thickness;
+  for (const auto& h : rig.handles()) header.handleNames.push_back(h.name);
+  cache::CacheWriter writer(report.cachePath, header);
+
+  cache::FrameRecord record;
+  record.triangles = sheet.triangles;
+  record.regionOfTriangle = sheet.regionOfTriangle;
+  for (auto t : sheet.regionTypes) record.regionTypes.push_back(static_cast<std::uint8_t>(t));
+  record.pattern = sheet.pattern;
+  report.vertices = sheet.vertexCount();
+  report.triangles = sheet.triangleCount();
+
+  const long frameCount = range.last - scene.frameStart + 1;
+  Progress progress(render ? "crumple run" : "crumple simulate", frameCount, options.log,
+                    options.interactive);
+  const double dt = 1.0 / (scene.fps * scene.substeps);
+  const sim::PinFunction pins = [&rig](double t, std::vector<sim::Pin>& out) { rig.pins(t, out); };
+
+  auto emit = [&](int frame) {
+    const double t = frameTime(scene, frame);
+    record.frame = frame;
+    record.time = t;
+    record.positions = elastic.positions();
+    record.handleVertices.clear();
+    record.handleTargets.clear();
+    for (std::size_t h = 0; h < rig.handles().size(); ++h) {
+      const auto& bound = rig.handles()[h];
+      const bool held = !(bound.releases && t >= bound.releaseTime);
+      record.handleVertices.push_back(held ? bound.vertex : -1);
+      record.handleTargets.push_back(rig.target(h, t));
+    }
+    record.camera = cameraAt(scene, animation.get(), t);
+    auto start = Clock::now();
+    writer.append(record);
+    report.stages["cache"].totalMs += msSince(start);
+    report.stages["cache"].frames += 1;
+    const auto m = measureFrame(record);
+    report.maxHandleError = std::max(report.maxHandleError, m.handleError);
+    report.maxStrain = std::max(report.maxStrain, m.maxStrain);
+    ++report.framesSimulated;
+    if (renderer && frame >= range.first) {
+      start = Clock::now();
+      renderer->render(record);
+      report.stages["render"].totalMs += msSince(start);
+      report.stages["render"].frames += 1;
+      ++report.framesRendered;
+    }
+    progress.update(frame - scene.frameStart + 1);
+  };
+
+  try {
+    emit(scene.frameStart);
+    for (int frame = scene.frameStart + 1; frame <= range.last; ++frame) {
+      const auto start = Clock::now();
+      for (int s = 0; s < scene.substeps; ++s) {
+        const double t = frameTime(scene, frame - 1) + s * dt;
+        try {
+          const auto stats = elastic.advance(t, dt, pins);
+          report.newtonIterations += stats.newtonIterations;
+          report.halvings += stats.halvings;
+          ++report.substeps;
+        } catch (const NumericalError& e) {
+          throw NumericalError(e.stage(), frame, e.what());
+        }
+      }
+      report.stages["elastic"].totalMs += msSince(start);
+      report.stages["elastic"].frames += 1;
+      emit(frame);
+    }
+  } catch (const NumericalError& e) {
+    progress.finish();
+    report.error = e.what();
+    writer.close();  // the cache stays valid up to the last good frame
+    writeTextAtomically(report.summaryPath, summaryJson(scene, report));
+    throw;
+  }
+  progress.finish();
+  writer.close();
+  if (report.halvings > 0)
+    report.warnings.push_back("the elastic solve halved its substep " +
+                              std::to_string(report.halvings) +
+                              " times; consider more [scene] substeps");
+  writeTextAtomically(report.summaryPath, summaryJson(scene, report));
+  return report;
+}
+
+RenderReport renderCache(const std::string& cachePath, const RenderOptions& options) {
+  const cache::CacheReader reader(cachePath);
+  if (reader.frameCount() == 0) throw InputError(cachePath, "the cache holds no frames");
+  const auto& header = reader.header();
+  const io::SceneSpec scene = io::parseScene(header.sceneText, header.sceneFile + " (in " + cachePath + ")",
+                                             fs::path(header.sceneFile).parent_path().string());
+  RenderReport report;
+  report.framesDir = !options.framesDir.empty()
+                         ? options.framesDir
+                         : (fs::path(cachePath).parent_path() / "frames").string();
+  const int firstCached = reader.readFrame(0).frame;
+  const int lastCached = firstCached + static_cast<int>(reader.frameCount()) - 1;
+  FrameRange range{firstCached, lastCached};
+  if (options.frames) {
+    range = *options.frames;
+    if (range.first < firstCached || range.last > lastCached)
+      throw InputError(cachePath, "--frames " + std::to_string(range.first) + "-" +
+                                      std::to_string(range.last) + " is outside the cached frames " +
+                                      std::to_string(firstCached) + "-" + std::to_string(lastCached));
+  }
+  prepareOutputDir(report.framesDir, "frames");
+  FrameRenderer renderer(scene, report.framesDir);
+  Progress progress("crumple render", range.last - range.first + 1, options.log, options.interactive);
+  for (int f = range.first; f <= range.last; ++f) {
+    const auto frame = reader.readFrame(static_cast<std::size_t>(f - firstCached));
+    const auto start = Clock::now();
+    renderer.render(frame);
+    report.cost.totalMs += msSince(start);
+    report.cost.frames += 1;
+    ++report.framesRendered;
+    progress.update(f - range.first + 1);
+  }
+  progress.finish();
+  return report;
+}
+
+std::string summaryText(const ShotReport& r) {
+  std::string out;
+  char line[512];
+  std::snprintf(line, sizeof line, "%d frames simulated (%zu vertices, %zu triangles), %d rendered\n",
+                r.framesSimulated, r.vertices, r.triangles, r.framesRendered);
+  out += line;
+  for (const auto& [name, cost] : r.stages) {
+    std::snprintf(line, sizeof line, "  %-8s %9.2f ms/frame over %ld frames\n", name.c_str(),
+                  cost.msPerFrame(), cost.frames);
+    out += line;
+  }
+  std::snprintf(line, sizeof line,
+                "  newton   %.2f iterations/substep, %ld halvings; max handle error %.3g m, max "
+                "edge strain %.3g\n",
+                r.substeps > 0 ? static_cast<double>(r.newtonIterations) / r.substeps : 0.0,
+                r.halvings, r.maxHandleError, r.maxStrain);
+  out += line;
+  out += "  cache:   " + r.cachePath + "\n";
+  if (!r.framesDir.empty()) out += "  frames:  " + r.framesDir + "/\n";
+  out += "  summary: " + r.summaryPath + "\n";
+  for (const auto& w : r.warnings) out += "  warning: " + w + "\n";
+  return out;
+}
+
+std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
+  JsonWriter j;
+  j.beginObject();
+  j.key("scene").value(scene.name);
+  j.key("scene_file").value(scene.file);
+  j.key("cache").value(r.cachePath);
+  j.key("frames_dir").value(r.framesDir);
+  j.key("frames_simulated").value(r.framesSimulated);
+  j.key("frames_rendered").value(r.framesRendered);
+  j.key("vertices").value(r.vertices);
+  j.key("triangles").value(r.triangles);
+  j.key("substeps_per_frame").value(scene.substeps);
+  // What ran: a scene pays only for what it uses (DESIGN.md "Invariants").
+  j.key("ran").beginObject();
+  j.key("elastic").value(true);
+  j.key("crumpling_model").value(false);
+  j.key("contacts").value(false);
+  j.key("self_contact").value(false);
+  j.key("tearing").value(false);
+  j.key("sound").value(false);
+  j.key("render_osmesa").value(r.framesRendered > 0);
+  j.endObject();
+  j.key("ms_per_frame").beginObject();
+  for (const auto& [name, cost] : r.stages) j.key(name).value(cost.msPerFrame());
+  j.endObject();
+  j.key("newton_iterations").value(static_cast<long long>(r.newtonIterations));
+  j.key("substep_halvings").value(static_cast<long long>(r.halvings));
+  j.key("max_handle_error").value(r.maxHandleError);
+  j.key("max_edge_strain").value(r.maxStrain);
+  j.key("warnings").beginArray();
+  for (const auto& w : r.warnings) j.value(w);
+  j.endArray();
+  j.key("error").value(r.error);
+  j.endObject();
+  return j.str() + "\n";
+}
+
+}  // namespace crumple::pipeline

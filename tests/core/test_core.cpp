@@ -1,0 +1,75 @@
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <numeric>
+#include <set>
+#include <vector>
+
+#include "crumple/core/crc32.hpp"
+#include "crumple/core/parallel.hpp"
+#include "crumple/core/rng.hpp"
+#include "crumple/core/units.hpp"
+
+using namespace crumple;
+
+TEST(Crc32, MatchesTheStandardCheckValue) {
+  const char* s = "123456789";
+  EXPECT_EQ(crc32(s, std::strlen(s)), 0xCBF43926U);
+  // Incremental use gives the same value.
+  EXPECT_EQ(crc32(s + 4, 5, crc32(s, 4)), 0xCBF43926U);
+  EXPECT_EQ(crc32(nullptr, 0), 0U);
+}
+
+TEST(CounterRng, IsAPureFunctionOfItsKey) {
+  const CounterRng a(42, 7, RngPurpose::SingularityPlacement);
+  const CounterRng b(42, 7, RngPurpose::SingularityPlacement);
+  for (std::uint64_t i = 0; i < 100; ++i) EXPECT_EQ(a.bits(i), b.bits(i));
+  // Any part of the key changes the stream.
+  EXPECT_NE(a.bits(0), CounterRng(43, 7, RngPurpose::SingularityPlacement).bits(0));
+  EXPECT_NE(a.bits(0), CounterRng(42, 8, RngPurpose::SingularityPlacement).bits(0));
+  EXPECT_NE(a.bits(0), CounterRng(42, 7, RngPurpose::FiberTexture).bits(0));
+}
+
+TEST(CounterRng, UniformIsInRangeWithPlausibleMean) {
+  const CounterRng r(1, 0, RngPurpose::Generic);
+  double sum = 0.0;
+  std::set<std::uint64_t> distinct;
+  constexpr int n = 100000;
+  for (int i = 0; i < n; ++i) {
+    const double u = r.uniform(static_cast<std::uint64_t>(i));
+    ASSERT_GE(u, 0.0);
+    ASSERT_LT(u, 1.0);
+    sum += u;
+    distinct.insert(r.bits(static_cast<std::uint64_t>(i)));
+  }
+  EXPECT_NEAR(sum / n, 0.5, 0.005);
+  EXPECT_EQ(distinct.size(), static_cast<std::size_t>(n));
+}
+
+TEST(Units, KnownAndUnknown) {
+  EXPECT_DOUBLE_EQ(*metresPerUnit("cm"), 0.01);
+  EXPECT_DOUBLE_EQ(*metresPerUnit("m"), 1.0);
+  EXPECT_DOUBLE_EQ(*metresPerUnit("mm"), 0.001);
+  EXPECT_DOUBLE_EQ(*metresPerUnit("in"), 0.0254);
+  EXPECT_FALSE(metresPerUnit("furlong").has_value());
+}
+
+TEST(ParallelFor, CoversEveryIndexOnceForAnyThreadCount) {
+  for (int threads : {1, 2, 3, 8}) {
+    setThreadCount(threads);
+    std::vector<int> hits(10007, 0);
+    parallelFor(hits.size(), [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) ++hits[i];
+    }, 16);
+    for (int h : hits) ASSERT_EQ(h, 1) << "threads " << threads;
+  }
+  setThreadCount(1);
+}
+
+TEST(ParallelFor, RethrowsAWorkerException) {
+  setThreadCount(2);
+  EXPECT_THROW(parallelFor(1000, [](std::size_t b, std::size_t) {
+    if (b > 0) throw std::runtime_error("boom");
+  }, 10), std::runtime_error);
+  setThreadCount(1);
+}

@@ -1,0 +1,86 @@
+#include <gtest/gtest.h>
+
+#include "crumple/mesh/sheet_mesh.hpp"
+
+using namespace crumple;
+using namespace crumple::mesh;
+
+TEST(RectangleSheet, IsAValidCrissCrossGrid) {
+  const auto m = makeRectangleSheet(0.21, 0.297, 0.03);
+  EXPECT_EQ(validate(m), "");
+  // 7 x 10 cells, 4 triangles each, corners + centres as vertices.
+  EXPECT_EQ(m.triangleCount(), 7u * 10u * 4u);
+  EXPECT_EQ(m.vertexCount(), 8u * 11u + 7u * 10u);
+  double area = 0.0;
+  for (const auto& t : m.triangles) {
+    const Vec2 e1 = m.pattern[t[1]] - m.pattern[t[0]];
+    const Vec2 e2 = m.pattern[t[2]] - m.pattern[t[0]];
+    const double a = 0.5 * (e1.x() * e2.y() - e1.y() * e2.x());
+    EXPECT_GT(a, 0.0) << "triangles are counter-clockwise in the pattern";
+    area += a;
+  }
+  EXPECT_NEAR(area, 0.21 * 0.297, 1e-12);
+  // Every corner of the sheet is a vertex.
+  for (const Vec2& c : {Vec2(0, 0), Vec2(0.21, 0), Vec2(0, 0.297), Vec2(0.21, 0.297)})
+    EXPECT_LT((m.pattern[nearestPatternVertex(m, c)] - c).norm(), 1e-12);
+}
+
+TEST(BuildEdges, CountsHingesAndBoundary) {
+  const auto m = makeRectangleSheet(1.0, 1.0, 0.5);  // 2 x 2 cells
+  const auto edges = buildEdges(m);
+  int boundary = 0, interior = 0;
+  for (const auto& e : edges) {
+    EXPECT_LT(e.v[0], e.v[1]);
+    if (e.interior()) {
+      ++interior;
+      for (int k = 0; k < 2; ++k) {
+        const auto& t = m.triangles[e.triangles[k]];
+        const int opp = e.opposite[k];
+        EXPECT_TRUE(opp != e.v[0] && opp != e.v[1]);
+        EXPECT_TRUE(t[0] == opp || t[1] == opp || t[2] == opp);
+      }
+    } else {
+      ++boundary;
+    }
+  }
+  EXPECT_EQ(boundary, 8);
+  // Euler: E = V + F - 1 for a disc; V = 9 + 4, F = 16.
+  EXPECT_EQ(boundary + interior, 13 + 16 - 1);
+}
+
+TEST(BuildEdges, RejectsNonManifold) {
+  SheetMesh m;
+  m.pattern = {Vec2(0, 0), Vec2(1, 0), Vec2(0, 1), Vec2(1, 1), Vec2(0.5, -1)};
+  m.positions.assign(5, Vec3::Zero());
+  m.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};
+  EXPECT_THROW(buildEdges(m), std::invalid_argument);
+}
+
+TEST(Validate, FindsBadMeshes) {
+  auto m = makeRectangleSheet(1.0, 1.0, 1.0);
+  EXPECT_EQ(validate(m), "");
+  auto bad = m;
+  bad.triangles[0][1] = 99;
+  EXPECT_NE(validate(bad), "");
+  bad = m;
+  bad.positions[0].x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(validate(bad), "");
+  bad = m;
+  bad.pattern[bad.triangles[0][1]] = bad.pattern[bad.triangles[0][0]];
+  EXPECT_NE(validate(bad), "");
+}
+
+TEST(PlacePattern, MapsAxes) {
+  auto m = makeRectangleSheet(2.0, 1.0, 1.0);
+  placePattern(m, Vec3(1, 2, 3), Vec3::UnitZ(), Vec3::UnitY());
+  for (std::size_t i = 0; i < m.vertexCount(); ++i)
+    EXPECT_TRUE(m.positions[i].isApprox(Vec3(1, 2 + m.pattern[i].y(), 3 + m.pattern[i].x())));
+  EXPECT_EQ(vertexNeighbours(m, 0).size(), 3u);  // a corner: two sides and the cell centre
+}
+
+TEST(RectangleSheet, RejectsBadSizes) {
+  EXPECT_THROW(makeRectangleSheet(-1.0, 1.0, 0.1), std::invalid_argument);
+  EXPECT_THROW(makeRectangleSheet(1.0, 0.0, 0.1), std::invalid_argument);
+  EXPECT_THROW(makeRectangleSheet(1.0, 1.0, std::numeric_limits<double>::quiet_NaN()),
+               std::invalid_argument);
+}

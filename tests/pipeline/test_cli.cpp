@@ -1,0 +1,177 @@
+// The `crumple` command line as a user and a farm see it: help, exit codes,
+// bad inputs, progress lines, determinism across thread counts.
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "test_util.hpp"
+
+using namespace crumple::testing;
+
+TEST(Cli, HelpForEverySubcommand) {
+  const auto top = runCrumple("--help");
+  EXPECT_EQ(top.status, 0);
+  for (const char* sub : {"run", "simulate", "render", "inspect"}) {
+    EXPECT_NE(top.output.find(sub), std::string::npos) << sub;
+    const auto r = runCrumple(std::string(sub) + " --help");
+    EXPECT_EQ(r.status, 0) << sub;
+    EXPECT_NE(r.output.find("--"), std::string::npos) << sub;
+  }
+  EXPECT_EQ(runCrumple("").status, 2) << "a subcommand is required";
+  EXPECT_EQ(runCrumple("frobnicate").status, 2);
+  EXPECT_EQ(runCrumple("run").status, 2) << "SCENE is required";
+}
+
+TEST(Cli, RunWritesCacheFramesSummaryAndProgressLines) {
+  TempDir tmp;
+  writeSmallScene(tmp / "scene");
+  const auto r = runCrumple("run " + (tmp / "scene").string() + " --out " + (tmp / "out").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(fs::exists(tmp / "out/cache.pcache"));
+  EXPECT_TRUE(fs::exists(tmp / "out/summary.json"));
+  for (int f = 1; f <= 6; ++f) {
+    char name[16];
+    std::snprintf(name, sizeof name, "%04d.png", f);
+    EXPECT_TRUE(fs::exists(tmp / "out/frames" / name)) << name;
+  }
+  // Not a terminal: one PROGRESS line per frame, ending at 100.
+  std::size_t lines = 0, pos = 0;
+  while ((pos = r.output.find("PROGRESS ", pos)) != std::string::npos) { ++lines; ++pos; }
+  EXPECT_EQ(lines, 6u);
+  EXPECT_NE(r.output.find("PROGRESS 100"), std::string::npos);
+  // The closing summary says where things went and what each stage cost.
+  EXPECT_NE(r.output.find("cache.pcache"), std::string::npos);
+  EXPECT_NE(r.output.find("ms/frame"), std::string::npos);
+  const auto summary = readFile(tmp / "out/summary.json");
+  EXPECT_NE(summary.find("\"elastic\""), std::string::npos);
+  EXPECT_NE(summary.find("\"tearing\":false"), std::string::npos);
+}
+
+TEST(Cli, InspectJsonHasTheDocumentedKeys) {
+  TempDir tmp;
+  writeSmallScene(tmp / "scene");
+  ASSERT_EQ(runCrumple("simulate " + (tmp / "scene").string() + " --out " + (tmp / "out").string()).status, 0);
+  EXPECT_FALSE(fs::exists(tmp / "out/frames")) << "simulate renders nothing";
+  const auto r = runCommand(std::string(CRUMPLE_BIN) + " inspect --json " + (tmp / "out/cache.pcache").string() + " 2>/dev/null");
+  ASSERT_EQ(r.status, 0);
+  for (const char* key : {"\"format_version\"", "\"fps\"", "\"frame_count\":6", "\"frames\"",
+                          "\"frame\"", "\"time\"", "\"vertices\"", "\"triangles\"", "\"c_mean\"",
+                          "\"n_comp\"", "\"max_strain\"", "\"handle_error\"", "\"handles\"",
+                          "\"name\":\"left\"", "\"position\"", "\"singular_vertices\":0",
+                          "\"junction_vertices\":0", "\"tears\":0"})
+    EXPECT_NE(r.output.find(key), std::string::npos) << key;
+  EXPECT_EQ(r.output.front(), '{');
+  const auto text = runCrumple("inspect " + (tmp / "out/cache.pcache").string());
+  EXPECT_EQ(text.status, 0);
+  EXPECT_NE(text.output.find("c_mean"), std::string::npos);
+}
+
+TEST(Cli, RenderAFrameRangeFromTheCacheAlone) {
+  TempDir tmp;
+  writeSmallScene(tmp / "scene");
+  ASSERT_EQ(runCrumple("run " + (tmp / "scene").string() + " --out " + (tmp / "a").string()).status, 0);
+  // The render command needs only the cache: move the scene away.
+  fs::remove_all(tmp / "scene");
+  const auto r = runCrumple("render " + (tmp / "a/cache.pcache").string() + " --frames 3-4 --backend osmesa --out " +
+                         (tmp / "b").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_FALSE(fs::exists(tmp / "b/0002.png"));
+  EXPECT_TRUE(fs::exists(tmp / "b/0005.png") == false);
+  for (const char* f : {"0003.png", "0004.png"})
+    EXPECT_EQ(readFile(tmp / "b" / f), readFile(tmp / "a/frames" / f)) << f << " re-rendered identically";
+  EXPECT_EQ(runCrumple("render " + (tmp / "a/cache.pcache").string() + " --frames 5-9").status, 2);
+  EXPECT_EQ(runCrumple("render " + (tmp / "a/cache.pcache").string() + " --backend vulkan").status, 2);
+}
+
+TEST(Cli, SameSeedGivesIdenticalBytesOnOneAndTwoThreads) {
+  TempDir tmp;
+  writeSmallScene(tmp / "scene");
+  ASSERT_EQ(runCrumple("run " + (tmp / "scene").string() + " --threads 1 --out " + (tmp / "t1").string()).status, 0);
+  ASSERT_EQ(runCrumple("run " + (tmp / "scene").string() + " --threads 2 --out " + (tmp / "t2").string()).status, 0);
+  ASSERT_EQ(runCrumple("run " + (tmp / "scene").string() + " --threads 1 --out " + (tmp / "t3").string()).status, 0);
+  const auto c1 = readFile(tmp / "t1/cache.pcache");
+  ASSERT_FALSE(c1.empty());
+  EXPECT_EQ(c1, readFile(tmp / "t2/cache.pcache"));
+  EXPECT_EQ(c1, readFile(tmp / "t3/cache.pcache"));
+  for (int f = 1; f <= 6; ++f) {
+    char name[16];
+    std::snprintf(name, sizeof name, "%04d.png", f);
+    const auto png = readFile(tmp / "t1/frames" / name);
+    ASSERT_FALSE(png.empty());
+    EXPECT_EQ(png, readFile(tmp / "t2/frames" / name)) << name;
+    EXPECT_EQ(png, readFile(tmp / "t3/frames" / name)) << name;
+  }
+}
+
+// Every bad input exits 2, names the file and the problem, and leaves no
+// cache or frames behind.
+class BadInput : public ::testing::Test {
+ protected:
+  void expectRejected(const std::string& args, const std::vector<std::string>& mentions) {
+    const auto r = runCrumple(args + " --out " + (tmp_ / "out").string());
+    EXPECT_EQ(r.status, 2) << r.output;
+    for (const auto& m : mentions) EXPECT_NE(r.output.find(m), std::string::npos) << "missing '" << m << "' in: " << r.output;
+    EXPECT_FALSE(fs::exists(tmp_ / "out/cache.pcache"));
+    EXPECT_FALSE(fs::exists(tmp_ / "out/frames/0001.png"));
+  }
+  TempDir tmp_;
+};
+
+TEST_F(BadInput, MissingSceneFile) {
+  expectRejected("run " + (tmp_ / "nope/scene.toml").string(), {"nope/scene.toml"});
+}
+
+TEST_F(BadInput, MalformedGltf) {
+  writeSmallScene(tmp_ / "s");
+  writeFile(tmp_ / "s/anim.gltf", "{ \"asset\": { \"version\": \"2.0\" }, \"nodes\": [ oops");
+  expectRejected("run " + (tmp_ / "s").string(), {"anim.gltf"});
+}
+
+TEST_F(BadInput, MissingHandleNode) {
+  writeSmallScene(tmp_ / "s");
+  auto scene = smallSceneToml();
+  scene.replace(scene.find("node = \"B\""), 10, "node = \"Nobody\"");
+  writeFile(tmp_ / "s/scene.toml", scene);
+  expectRejected("run " + (tmp_ / "s").string(), {"scene.toml", "Nobody"});
+}
+
+TEST_F(BadInput, NanKeyframe) {
+  writeSmallScene(tmp_ / "s");
+  writeFile(tmp_ / "s/anim.gltf", smallAnimation(std::numeric_limits<float>::quiet_NaN()));
+  expectRejected("run " + (tmp_ / "s").string(), {"anim.gltf"});
+}
+
+TEST_F(BadInput, UnknownTomlKey) {
+  writeSmallScene(tmp_ / "s");
+  writeFile(tmp_ / "s/scene.toml", smallSceneToml("wobble = 3\n"));
+  // [sheet] wobble is on line 16 of the generated scene.
+  expectRejected("run " + (tmp_ / "s").string(), {"scene.toml:16", "wobble"});
+}
+
+TEST_F(BadInput, NegativeSheetSize) {
+  writeSmallScene(tmp_ / "s");
+  auto scene = smallSceneToml();
+  scene.replace(scene.find("width = 10.0"), 12, "width = -10.0");
+  writeFile(tmp_ / "s/scene.toml", scene);
+  expectRejected("run " + (tmp_ / "s").string(), {"scene.toml", "width"});
+}
+
+TEST_F(BadInput, UnwritableOutputFolder) {
+  writeSmallScene(tmp_ / "s");
+  // A path below a regular file can never be created, even by root.
+  writeFile(tmp_ / "blocker", "x");
+  const auto r = runCrumple("run " + (tmp_ / "s").string() + " --out " + (tmp_ / "blocker/out").string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("blocker/out"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(tmp_ / "blocker/out"));
+}
+
+TEST_F(BadInput, BadFrameRangeAndCorruptCache) {
+  writeSmallScene(tmp_ / "s");
+  expectRejected("run " + (tmp_ / "s").string() + " --frames 4-2", {"--frames"});
+  expectRejected("run " + (tmp_ / "s").string() + " --frames 1-99", {"--frames"});
+  writeFile(tmp_ / "junk.pcache", "definitely not a cache");
+  const auto r = runCrumple("inspect " + (tmp_ / "junk.pcache").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("junk.pcache"), std::string::npos) << r.output;
+}
