@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,17 @@ namespace crumple::cache {
 
 inline constexpr std::uint32_t kFormatVersion = 1;
 
+// An extension sub-block: data a later format revision attaches to the
+// header or to a frame (tear-atlas references, sound events, ...) without
+// breaking older readers. A reader keeps the sub-blocks it does not interpret
+// here, verbatim and in file order, so a cache can be copied losslessly; the
+// writer writes them back as given. Tags are four bytes, any values.
+struct ExtensionBlock {
+  std::array<char, 4> tag{};
+  std::vector<std::uint8_t> data;
+  bool operator==(const ExtensionBlock&) const = default;
+};
+
 struct CacheHeader {
   std::uint32_t formatVersion = kFormatVersion;
   double fps = 24.0;
@@ -25,13 +37,14 @@ struct CacheHeader {
   int substeps = 1;
   std::uint64_t seed = 0;
   std::string sceneName;
-  std::string sceneFile;   // path of the scene file the shot came from
-  std::string sceneText;   // the scene file's text (renderers re-parse it)
+  std::string sceneFile;     // path of the scene file the shot came from
+  std::string sceneText;     // the scene file's text (renderers re-parse it)
   double sheetWidth = 0.0;   // m (0 for a pattern mesh)
   double sheetHeight = 0.0;  // m
   std::string paperName;
   double paperThickness = 0.0;  // m
   std::vector<std::string> handleNames;
+  std::vector<ExtensionBlock> extensions;  // sub-blocks this version does not interpret
 };
 
 struct CameraRecord {
@@ -60,11 +73,29 @@ struct FrameRecord {
   std::vector<int> handleVertices;
   std::vector<Vec3> handleTargets;
   CameraRecord camera;
+  std::vector<ExtensionBlock> extensions;  // sub-blocks this version does not interpret
 };
 
 // Writes a cache. Frames are appended in order; close() writes the footer.
-// A writer destroyed without close() leaves a footer-less file that
-// CacheReader recovers.
+// The file is written in place (no temporary): the header at construction,
+// then append() writes one complete frame chunk and flushes it, so a killed
+// process leaves every appended frame readable.
+//
+// The destructor does NOT write the footer: a writer destroyed without
+// close() (an exception unwinding, a crash) leaves a footer-less file that
+// looks like the crashed run it is, and CacheReader recovers its complete
+// frames (recovered() == true). Call close() explicitly on success, and also
+// after a clean numerical failure (the cache is then valid up to the last
+// good frame).
+//
+// append() takes the full frame; the topology (triangles, regionOfTriangle,
+// regionTypes, pattern) is stored only when it differs bit for bit from the
+// previous appended frame's (always for the first frame). Frame numbers must
+// increase strictly (std::invalid_argument otherwise). The header's
+// formatVersion is ignored: the writer always writes kFormatVersion.
+// Identical input gives a byte-identical file.
+// I/O failures (cannot create, cannot write) throw InputError naming the path;
+// after a failed write the writer refuses further appends and close() throws.
 class CacheWriter {
  public:
   // Throws InputError if the file cannot be created.
@@ -73,6 +104,8 @@ class CacheWriter {
   CacheWriter(const CacheWriter&) = delete;
   CacheWriter& operator=(const CacheWriter&) = delete;
   void append(const FrameRecord& frame);
+  // Writes the footer and trailer and closes the file. A second call does
+  // nothing; append() after close() throws std::logic_error.
   void close();
   std::size_t framesWritten() const;
 
@@ -85,6 +118,7 @@ class CacheWriter {
 struct CacheIssue {
   int frameIndex = -1;
   std::string message;
+  std::optional<int> frame;  // the frame number, when known
 };
 
 class CacheReader {
@@ -105,7 +139,19 @@ class CacheReader {
   const std::vector<CacheIssue>& issues() const;
   // Full frame (topology carried forward from earlier frames). Throws
   // CorruptDataError naming the frame number when its CRC does not match.
+  // std::out_of_range for index >= frameCount(). Thread-safe (each call
+  // reads the file on its own).
   FrameRecord readFrame(std::size_t index) const;
+
+  // Reads every indexed frame chunk and checks its CRC and structure (opening
+  // with an intact footer checks none of them). One issue per bad frame,
+  // naming its frame number; empty when all are good.
+  std::vector<CacheIssue> verifyAll() const;
+  // From the index, without reading the frame: its frame number, and the
+  // index of the frame whose chunk holds its topology (itself if it has one).
+  int frameNumber(std::size_t index) const;
+  std::size_t topologySource(std::size_t index) const;
+  const std::string& path() const;
 
  private:
   struct Impl;
