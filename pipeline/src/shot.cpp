@@ -31,10 +31,8 @@ double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-// Time of a frame: the scene's first frame is t = 0 s (DCC frame f at (f - first) / fps).
-double frameTime(const io::SceneSpec& scene, int frame) {
-  return static_cast<double>(frame - scene.frameStart) / scene.fps;
-}
+// Animation time of a frame: f / fps, the DCC convention (docs/SCENE.md "Time").
+double frameTime(const io::SceneSpec& scene, int frame) { return scene.frameTime(frame); }
 
 std::string frameFileName(int frame) {
   char name[32];
@@ -75,7 +73,7 @@ cache::CameraRecord cameraAt(const io::SceneSpec& scene, const io::AnimationScen
                                        animation->file());
     rec.position = cam->position;
     rec.rotation = cam->rotation;
-    rec.yfov = cam->yfov > 0.0 ? cam->yfov : scene.camera.yfov;
+    rec.yfov = cam->yfov > 0.0 && !scene.camera.fovExplicit ? cam->yfov : scene.camera.yfov;
     return rec;
   }
   const auto c = render::Camera::lookAt(scene.camera.position, scene.camera.lookAt,
@@ -255,8 +253,10 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   // Everything that can be wrong with the input is checked before any output
   // is written: no partial cache or frames that look valid.
   std::unique_ptr<io::AnimationScene> animation;
-  if (!scene.animationFile.empty())
+  if (!scene.animationFile.empty()) {
     animation = std::make_unique<io::AnimationScene>(io::AnimationScene::load(scene.animationFile));
+    io::checkAnimationNodes(scene, *animation);
+  }
   mesh::SheetMesh sheet = buildSheet(scene, animation.get());
   const double t0 = frameTime(scene, scene.frameStart);
   const HandleRig rig(scene, animation.get(), sheet, t0);
@@ -264,6 +264,8 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   for (int f = scene.frameStart; f <= range.last; ++f) (void)cameraAt(scene, animation.get(), frameTime(scene, f));
   prepareOutputDir(report.outDir, "output");
   report.cachePath = (fs::path(report.outDir) / "cache.pcache").string();
+  if (animation)
+    for (const auto& w : animation->warnings()) report.warnings.push_back(animation->file() + ": " + w);
   report.summaryPath = (fs::path(report.outDir) / "summary.json").string();
   std::unique_ptr<FrameRenderer> renderer;
   if (render) {
@@ -346,7 +348,8 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     for (int frame = scene.frameStart + 1; frame <= range.last; ++frame) {
       const auto start = Clock::now();
       for (int s = 0; s < scene.substeps; ++s) {
-        const double t = frameTime(scene, frame - 1) + s * dt;
+        // Substep s of frame f starts at ((f - 1) * substeps + s) * dt.
+        const double t = static_cast<double>((frame - 1) * scene.substeps + s) * dt;
         try {
           const auto stats = elastic.advance(t, dt, pins);
           report.newtonIterations += stats.newtonIterations;

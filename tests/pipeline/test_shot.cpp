@@ -71,8 +71,8 @@ TEST(Shot, HandlesTrackTheirCurvesForEveryFormat) {
   // One animation written as glTF, FBX and COLLADA (tests/io/data): the
   // cached handle vertex follows the imported track to 1e-6 m at every frame,
   // and the three formats give the same trajectories to 1e-5 m.
-  const std::vector<std::string> files = {"tests/io/data/anim.gltf", "tests/io/data/anim.fbx",
-                                          "tests/io/data/anim.dae"};
+  const std::vector<std::string> files = {"tests/io/data/anim.gltf", "tests/io/data/anim_zup_cm.fbx",
+                                          "tests/io/data/anim_zup_cm.dae"};
   std::vector<std::vector<Vec3>> trajectories;
   for (const auto& file : files) {
     TempDir tmp;
@@ -83,7 +83,7 @@ TEST(Shot, HandlesTrackTheirCurvesForEveryFormat) {
     const auto cameraAt = scene.find("[camera]");
     scene = scene.substr(0, first) + "[[handles]]\nname = \"h\"\nnode = \"Handle\"\n" +
             "[[handles]]\nname = \"c\"\nnode = \"Child\"\n" + scene.substr(cameraAt);
-    scene.replace(scene.find("frames = [1, 6]"), 15, "frames = [1, 49]");
+    scene.replace(scene.find("frames = [1, 6]"), 15, "frames = [0, 48]");
     writeFile(tmp / "s/scene.toml", scene);
     const auto spec = io::loadScene((tmp / "s/scene.toml").string());
     const auto report = pipeline::runShot(spec, quiet(tmp / "out"));

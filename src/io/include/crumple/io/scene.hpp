@@ -30,10 +30,11 @@ struct PaperPreset {
 struct SheetSpec {
   enum class Kind { Rectangle, PatternMesh };
   Kind kind = Kind::Rectangle;
-  double width = 0.0;   // m (Rectangle)
-  double height = 0.0;  // m (Rectangle)
-  std::string patternMesh;  // mesh node name in the animation file (PatternMesh)
-  double maxEdge = 0.0;     // m: simulation mesh resolution; 0 = min(width, height) / 16
+  double width = 0.0;        // m (Rectangle)
+  double height = 0.0;       // m (Rectangle)
+  std::string patternMesh;   // mesh node name in the animation file (PatternMesh)
+  long patternMeshLine = 0;  // scene file line of pattern_mesh (for errors)
+  double maxEdge = 0.0;      // m: simulation mesh resolution; 0 = min(width, height) / 16
   // Placement of the pattern in the world: x = origin + u * uAxis + v * vAxis.
   Vec3 origin = Vec3::Zero();
   Vec3 uAxis = Vec3::UnitX();
@@ -43,6 +44,7 @@ struct SheetSpec {
 struct HandleSpec {
   std::string name;                  // unique handle name (defaults to node)
   std::string node;                  // animated node in the animation file
+  long nodeLine = 0;                 // scene file line of `node` (for errors)
   std::optional<Vec2> patternPoint;  // m; nullopt = sheet point nearest the node at the first frame
   // Tangent-plane control (thesis 2.3.1): the node's rotation drives 2-4
   // neighbour vertices. tangentVertices 0 = automatic (2 at a corner, 3 on a
@@ -54,11 +56,15 @@ struct HandleSpec {
 
 struct CameraSpec {
   // Either a camera node of the animation file or a fixed camera from the scene.
-  std::string node;  // non-empty = take the camera from this animation node
+  std::string node;   // non-empty = take the camera from this animation node
+  long nodeLine = 0;  // scene file line of `node` (for errors)
   Vec3 position{0.0, 0.3, 0.6};
   Vec3 lookAt = Vec3::Zero();
   Vec3 up = Vec3::UnitY();
   double yfov = 0.6981317007977318;  // rad (40 degrees); focal_mm + sensor_mm override it
+  // True when the scene gave fov_deg or focal_mm: then yfov overrides the
+  // field of view of an animation-file camera (node).
+  bool fovExplicit = false;
   int width = 640;
   int height = 480;
 };
@@ -94,9 +100,9 @@ struct SimSpec {
 };
 
 struct SceneSpec {
-  std::string file;  // scene.toml path as given
-  std::string dir;   // folder holding it (relative paths resolve here)
-  std::string name;  // [scene] name, default: folder name
+  std::string file;           // scene.toml path as given
+  std::string dir;            // folder holding it (relative paths resolve here)
+  std::string name;           // [scene] name, default: folder name
   std::string animationFile;  // resolved path, may be empty (no handles then)
   double metresPerUnit = 1.0;
   double fps = 24.0;
@@ -114,6 +120,10 @@ struct SceneSpec {
   OutputSpec output;
   SimSpec sim;
   std::string sourceText;  // the scene file's text, kept for the cache header
+
+  // Animation time (s) of frame `frame`: frame / fps, the DCC convention
+  // (frame 0 at t = 0). See docs/SCENE.md "Time".
+  double frameTime(int frame) const { return static_cast<double>(frame) / fps; }
 };
 
 // Parse a scene file. Resolves the paper preset (see paperPresetDirs) and the
@@ -124,6 +134,13 @@ SceneSpec parseScene(std::string_view text, const std::string& sourceName,
                      const std::string& baseDir);
 // SCENE may be a scene.toml or a folder holding one.
 std::string resolveScenePath(const std::string& sceneOrFolder);
+
+class AnimationScene;
+// Check that every node the scene names exists in the loaded animation file:
+// handle nodes, the camera node (which must hold a camera) and the pattern
+// mesh (which must hold triangles). Throws InputError at the scene file's
+// line, e.g. "scene.toml:12: 'handles[0].node': drape.glb: no node named ...".
+void checkAnimationNodes(const SceneSpec& scene, const AnimationScene& animation);
 
 // Load one preset file; errors name the file, line and key.
 PaperPreset loadPaperPreset(const std::string& path);

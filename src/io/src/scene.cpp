@@ -1,0 +1,479 @@
+// The scene file parser (docs/SCENE.md is the schema).
+#include "crumple/io/scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <set>
+
+#include "crumple/core/error.hpp"
+#include "crumple/core/units.hpp"
+#include "crumple/io/animation.hpp"
+#include "toml_reader.hpp"
+
+namespace crumple::io {
+
+namespace fs = std::filesystem;
+using detail::formatNumber;
+using detail::TableReader;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kMaxSubsteps = 1024;
+constexpr std::int64_t kMaxResolution = 16384;
+
+class SceneParser {
+ public:
+  SceneParser(std::string_view text, const std::string& file, const std::string& baseDir)
+      : file_(file), baseDir_(baseDir), root_(detail::parseToml(text, file)) {
+    spec_.file = file;
+    spec_.dir = baseDir;
+    spec_.sourceText = std::string(text);
+  }
+
+  SceneSpec parse() {
+    const TableReader root(root_, "", file_);
+    root.allowOnly(
+        {"scene", "sheet", "paper", "handles", "camera", "lights", "ground", "output", "sim"});
+    // [scene] first: its `units` scales every length that follows.
+    parseScene(root.subTable("scene"));
+    const toml::table* sheet = root.subTable("sheet");
+    if (!sheet) throw InputError(file_, "'sheet': missing required table [sheet]");
+    parseSheet(*sheet);
+    parsePaper(root.subTable("paper"));
+    parseHandles(root);
+    parseCamera(root.subTable("camera"));
+    parseLights(root);
+    parseGround(root.subTable("ground"));
+    parseOutput(root.subTable("output"));
+    parseSim(root.subTable("sim"));
+    return std::move(spec_);
+  }
+
+ private:
+  double mpu() const { return spec_.metresPerUnit; }
+
+  std::string defaultName() const {
+    std::error_code ec;
+    fs::path p = fs::absolute(baseDir_.empty() ? fs::path(".") : fs::path(baseDir_), ec);
+    p = p.lexically_normal();
+    std::string name = p.filename().string();
+    if (name.empty()) name = p.parent_path().filename().string();
+    return name.empty() ? std::string("scene") : name;
+  }
+
+  void parseScene(const toml::table* table) {
+    spec_.name = defaultName();
+    if (!table) return;
+    const TableReader r(*table, "scene", file_);
+    r.allowOnly({"name", "units", "fps", "frames", "substeps", "seed", "animation"});
+    if (auto name = r.string("name")) {
+      if (name->empty()) r.fail("name", "must not be empty");
+      spec_.name = *name;
+    }
+    if (auto units = r.string("units")) {
+      const std::optional<double> m = metresPerUnit(*units);
+      if (!m) r.fail("units", "unknown unit '" + *units + "' (expected one of: m, cm, mm, in)");
+      spec_.metresPerUnit = *m;
+    }
+    if (auto fps = r.number("fps")) {
+      spec_.fps = r.requirePositive("fps", *fps);
+      if (spec_.fps > 10000.0) r.fail("fps", "must be <= 10000 (got " + formatNumber(*fps) + ")");
+    }
+    if (auto frames = r.intPair("frames")) {
+      const auto [a, b] = *frames;
+      constexpr std::int64_t lim = 100000000;
+      if (a < -lim || a > lim || b < -lim || b > lim) {
+        r.fail("frames", "frame numbers must be within +-" + std::to_string(lim));
+      }
+      if (a > b) {
+        r.fail("frames",
+               "first frame " + std::to_string(a) + " is after last frame " + std::to_string(b));
+      }
+      spec_.frameStart = static_cast<int>(a);
+      spec_.frameEnd = static_cast<int>(b);
+    }
+    if (auto s = r.integer("substeps")) {
+      if (*s < 1 || *s > kMaxSubsteps) {
+        r.fail("substeps", "must be in [1, " + std::to_string(kMaxSubsteps) + "] (got " +
+                               std::to_string(*s) + ")");
+      }
+      spec_.substeps = static_cast<int>(*s);
+    }
+    if (auto seed = r.integer("seed")) {
+      if (*seed < 0) r.fail("seed", "must be >= 0 (got " + std::to_string(*seed) + ")");
+      spec_.seed = static_cast<std::uint64_t>(*seed);
+    }
+    if (auto anim = r.string("animation")) {
+      if (anim->empty()) r.fail("animation", "must not be empty");
+      fs::path p(*anim);
+      if (p.is_relative()) p = fs::path(baseDir_.empty() ? "." : baseDir_) / p;
+      p = p.lexically_normal();
+      std::error_code ec;
+      if (!fs::is_regular_file(p, ec)) r.fail("animation", "no such file: " + p.string());
+      spec_.animationFile = p.string();
+    }
+  }
+
+  void parseSheet(const toml::table& table) {
+    const TableReader r(table, "sheet", file_);
+    r.allowOnly({"width", "height", "pattern_mesh", "max_edge", "origin", "u_axis", "v_axis"});
+    SheetSpec& s = spec_.sheet;
+    const bool rect = r.has("width") || r.has("height");
+    if (r.has("pattern_mesh")) {
+      if (rect) {
+        r.fail(r.has("width") ? "width" : "height",
+               "give either width/height or pattern_mesh, not both");
+      }
+      s.kind = SheetSpec::Kind::PatternMesh;
+      s.patternMesh = *r.string("pattern_mesh");
+      s.patternMeshLine = r.lineOf("pattern_mesh");
+      if (s.patternMesh.empty()) r.fail("pattern_mesh", "must not be empty");
+      if (spec_.animationFile.empty()) {
+        r.fail("pattern_mesh", "needs an animation file ([scene] animation) holding the mesh");
+      }
+      for (const char* key : {"origin", "u_axis", "v_axis"}) {
+        if (r.has(key)) {
+          r.fail(key, "only for a width/height rectangle (a pattern mesh is placed by its file)");
+        }
+      }
+    } else {
+      s.kind = SheetSpec::Kind::Rectangle;
+      const std::optional<double> w = r.number("width");
+      if (!w) r.missing("width");
+      const std::optional<double> h = r.number("height");
+      if (!h) r.missing("height");
+      s.width = r.requirePositive("width", *w) * mpu();
+      s.height = r.requirePositive("height", *h) * mpu();
+      if (auto o = r.vec3("origin")) s.origin = *o * mpu();
+      if (auto u = r.vec3("u_axis")) s.uAxis = r.requireDirection("u_axis", *u);
+      if (auto v = r.vec3("v_axis")) s.vAxis = r.requireDirection("v_axis", *v);
+      if (std::abs(s.uAxis.dot(s.vAxis)) > 1e-6) {
+        r.fail(r.has("v_axis") ? "v_axis" : "u_axis", "u_axis and v_axis must be perpendicular");
+      }
+    }
+    if (auto e = r.number("max_edge")) {
+      s.maxEdge = r.requirePositive("max_edge", *e) * mpu();
+      if (s.kind == SheetSpec::Kind::Rectangle && s.maxEdge > std::max(s.width, s.height)) {
+        r.fail("max_edge", "is larger than the sheet itself");
+      }
+    }
+  }
+
+  std::vector<std::string> availablePresets() const {
+    std::set<std::string> names;
+    for (const std::string& dir : paperPresetDirs()) {
+      std::error_code ec;
+      for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+        if (it->path().extension() == ".toml") names.insert(it->path().stem().string());
+      }
+    }
+    return {names.begin(), names.end()};
+  }
+
+  // Resolve a preset name; `fail` reports a problem at the right place.
+  template <class Fail>
+  PaperPreset findPreset(const std::string& name, Fail&& fail) const {
+    if (name.empty() || name.find_first_of("/\\") != std::string::npos || name == "." ||
+        name == "..") {
+      fail("must be a preset name such as 'office-70gsm', not a path");
+    }
+    std::string looked;
+    for (const std::string& dir : paperPresetDirs()) {
+      const fs::path p = fs::path(dir) / (name + ".toml");
+      std::error_code ec;
+      if (fs::is_regular_file(p, ec)) return loadPaperPreset(p.string());
+      looked += (looked.empty() ? "" : ", ") + dir;
+    }
+    std::string known;
+    for (const std::string& n : availablePresets()) known += (known.empty() ? "" : ", ") + n;
+    fail("unknown paper preset '" + name +
+         "' (looked in: " + (looked.empty() ? std::string("no directory") : looked) +
+         "; available: " + (known.empty() ? std::string("none") : known) + ")");
+    return {};
+  }
+
+  void parsePaper(const toml::table* table) {
+    if (!table) {
+      spec_.paper = findPreset(spec_.paperPreset, [&](const std::string& problem) {
+        throw InputError(file_, "'paper.preset': " + problem);
+      });
+      return;
+    }
+    const TableReader r(*table, "paper", file_);
+    r.allowOnly({"preset", "front_color", "back_color"});
+    if (auto preset = r.string("preset")) spec_.paperPreset = *preset;
+    spec_.paper = findPreset(spec_.paperPreset,
+                             [&](const std::string& problem) { r.fail("preset", problem); });
+    if (auto c = r.vec3("front_color"))
+      spec_.paper.frontColor = r.requireColor("front_color", *c, 1);
+    if (auto c = r.vec3("back_color")) spec_.paper.backColor = r.requireColor("back_color", *c, 1);
+  }
+
+  void parseHandles(const TableReader& root) {
+    const toml::array* handles = root.tableArray("handles");
+    if (!handles) return;
+    std::set<std::string> names;
+    for (std::size_t i = 0; i < handles->size(); ++i) {
+      const TableReader r(*handles->get(i)->as_table(), "handles[" + std::to_string(i) + "]",
+                          file_);
+      r.allowOnly(
+          {"name", "node", "pattern", "tangent_control", "tangent_vertices", "release_time"});
+      HandleSpec h;
+      const std::optional<std::string> node = r.string("node");
+      if (!node) r.missing("node");
+      if (node->empty()) r.fail("node", "must not be empty");
+      if (spec_.animationFile.empty()) {
+        r.fail("node",
+               "handles need an animation file ([scene] animation) holding node '" + *node + "'");
+      }
+      h.node = *node;
+      h.nodeLine = r.lineOf("node");
+      h.name = r.string("name").value_or(h.node);
+      if (h.name.empty()) r.fail("name", "must not be empty");
+      if (!names.insert(h.name).second) {
+        r.fail(r.has("name") ? "name" : "node", "duplicate handle name '" + h.name + "'");
+      }
+      if (auto p = r.vec2("pattern")) {
+        const Vec2 q = *p * mpu();
+        const SheetSpec& s = spec_.sheet;
+        if (s.kind == SheetSpec::Kind::Rectangle) {
+          const double tol = 1e-9 * std::max(s.width, s.height);
+          if (q.x() < -tol || q.x() > s.width + tol || q.y() < -tol || q.y() > s.height + tol) {
+            r.fail("pattern", "point [" + formatNumber((*p).x()) + ", " + formatNumber((*p).y()) +
+                                  "] is outside the sheet [0, " + formatNumber(s.width / mpu()) +
+                                  "] x [0, " + formatNumber(s.height / mpu()) + "]");
+          }
+        }
+        h.patternPoint = q;
+      }
+      h.tangentControl = r.boolean("tangent_control").value_or(false);
+      if (auto n = r.integer("tangent_vertices")) {
+        if (!(*n == 0 || (*n >= 2 && *n <= 4))) {
+          r.fail("tangent_vertices",
+                 "must be 0 (automatic) or 2, 3 or 4 (got " + std::to_string(*n) + ")");
+        }
+        if (*n != 0 && !h.tangentControl) {
+          r.fail("tangent_vertices", "needs tangent_control = true");
+        }
+        h.tangentVertices = static_cast<int>(*n);
+      }
+      if (auto t = r.number("release_time")) {
+        h.releaseTime = r.requireNonNegative("release_time", *t);
+      }
+      spec_.handles.push_back(std::move(h));
+    }
+  }
+
+  void parseCamera(const toml::table* table) {
+    if (!table) return;
+    const TableReader r(*table, "camera", file_);
+    r.allowOnly(
+        {"node", "position", "look_at", "up", "fov_deg", "focal_mm", "sensor_mm", "resolution"});
+    CameraSpec& c = spec_.camera;
+    if (auto res = r.intPair("resolution")) {
+      for (std::int64_t v : *res) {
+        if (v < 1 || v > kMaxResolution) {
+          r.fail("resolution", "width and height must be in [1, " + std::to_string(kMaxResolution) +
+                                   "] (got " + std::to_string(v) + ")");
+        }
+      }
+      c.width = static_cast<int>((*res)[0]);
+      c.height = static_cast<int>((*res)[1]);
+    }
+    if (auto node = r.string("node")) {
+      if (node->empty()) r.fail("node", "must not be empty");
+      if (spec_.animationFile.empty()) {
+        r.fail("node", "a camera node needs an animation file ([scene] animation)");
+      }
+      for (const char* key : {"position", "look_at", "up"}) {
+        if (r.has(key)) r.fail(key, "give either node or position/look_at/up, not both");
+      }
+      c.node = *node;
+      c.nodeLine = r.lineOf("node");
+    } else {
+      if (auto p = r.vec3("position")) c.position = *p * mpu();
+      if (auto l = r.vec3("look_at")) c.lookAt = *l * mpu();
+      if (auto u = r.vec3("up")) c.up = r.requireDirection("up", *u);
+      const Vec3 view = c.lookAt - c.position;
+      if (view.norm() < 1e-12) {
+        r.fail(r.has("look_at") ? "look_at" : "position", "look_at must differ from position");
+      }
+      if (view.normalized().cross(c.up).norm() < 1e-6) {
+        r.fail(r.has("up") ? "up" : "look_at", "up must not be parallel to the view direction");
+      }
+    }
+    if (r.has("fov_deg") && r.has("focal_mm")) {
+      r.fail("focal_mm", "give either fov_deg or focal_mm, not both");
+    }
+    if (r.has("sensor_mm") && !r.has("focal_mm")) r.fail("sensor_mm", "needs focal_mm");
+    if (auto fov = r.number("fov_deg")) {
+      if (!(*fov > 0.0 && *fov < 180.0)) {
+        r.fail("fov_deg", "must be in (0, 180) degrees (got " + formatNumber(*fov) + ")");
+      }
+      c.yfov = *fov * kPi / 180.0;
+      c.fovExplicit = true;
+    }
+    if (auto focal = r.number("focal_mm")) {
+      const double f = r.requirePositive("focal_mm", *focal);
+      const double sensor =
+          r.has("sensor_mm") ? r.requirePositive("sensor_mm", *r.number("sensor_mm")) : 36.0;
+      // sensor_mm is the sensor width; the vertical extent follows the aspect.
+      const double aspect = static_cast<double>(c.width) / static_cast<double>(c.height);
+      c.yfov = 2.0 * std::atan(sensor / aspect / (2.0 * f));
+      c.fovExplicit = true;
+    }
+  }
+
+  void parseLights(const TableReader& root) {
+    const toml::array* lights = root.tableArray("lights");
+    if (!lights) {
+      LightSpec key;
+      key.name = "key";
+      key.direction = Vec3(-0.4, -1.0, -0.3).normalized();
+      key.shadow = true;
+      LightSpec fill;
+      fill.name = "fill";
+      fill.direction = Vec3(0.6, -0.5, 0.4).normalized();
+      fill.intensity = 0.35;
+      fill.shadow = false;
+      spec_.lights = {key, fill};
+      return;
+    }
+    std::set<std::string> names;
+    for (std::size_t i = 0; i < lights->size(); ++i) {
+      const TableReader r(*lights->get(i)->as_table(), "lights[" + std::to_string(i) + "]", file_);
+      r.allowOnly({"name", "type", "direction", "position", "color", "intensity", "shadow"});
+      LightSpec l;
+      l.name = r.string("name").value_or("light" + std::to_string(i));
+      if (l.name.empty()) r.fail("name", "must not be empty");
+      if (!names.insert(l.name).second) r.fail("name", "duplicate light name '" + l.name + "'");
+      const std::string type = r.string("type").value_or("directional");
+      if (type == "directional") {
+        l.kind = LightSpec::Kind::Directional;
+        if (r.has("position")) r.fail("position", "only for point lights (type = \"point\")");
+        l.direction = l.direction.normalized();
+        if (auto d = r.vec3("direction")) l.direction = r.requireDirection("direction", *d);
+      } else if (type == "point") {
+        l.kind = LightSpec::Kind::Point;
+        if (r.has("direction")) {
+          r.fail("direction", "only for directional lights (type = \"directional\")");
+        }
+        const std::optional<Vec3> p = r.vec3("position");
+        if (!p) r.missing("position");
+        l.position = *p * mpu();
+      } else {
+        r.fail("type", "unknown light type '" + type + "' (expected directional or point)");
+      }
+      if (auto c = r.vec3("color")) l.color = r.requireColor("color", *c, 1.0);
+      if (auto v = r.number("intensity")) l.intensity = r.requireNonNegative("intensity", *v);
+      l.shadow = r.boolean("shadow").value_or(false);
+      spec_.lights.push_back(std::move(l));
+    }
+  }
+
+  void parseGround(const toml::table* table) {
+    if (!table) return;
+    const TableReader r(*table, "ground", file_);
+    r.allowOnly({"enabled", "height", "size", "color"});
+    GroundSpec& g = spec_.ground;
+    g.enabled = r.boolean("enabled").value_or(true);  // the table's presence enables it
+    if (auto h = r.number("height")) g.height = *h * mpu();
+    if (auto s = r.number("size")) g.size = r.requirePositive("size", *s) * mpu();
+    if (auto c = r.vec3("color")) g.color = r.requireColor("color", *c, 1.0);
+  }
+
+  void parseOutput(const toml::table* table) {
+    if (!table) return;
+    const TableReader r(*table, "output", file_);
+    r.allowOnly({"dir", "frames"});
+    if (auto d = r.string("dir")) spec_.output.dir = *d;
+    if (auto f = r.boolean("frames")) spec_.output.frames = *f;
+  }
+
+  void parseSim(const toml::table* table) {
+    if (!table) return;
+    const TableReader r(*table, "sim", file_);
+    r.allowOnly({"gravity", "mass_damping", "stiffness_damping", "max_newton_iterations"});
+    SimSpec& s = spec_.sim;
+    if (auto g = r.vec3("gravity")) {
+      if (g->norm() > 1000.0)
+        r.fail("gravity", "is implausibly large (m/s^2, not scaled by units)");
+      s.gravity = *g;
+    }
+    if (auto a = r.number("mass_damping")) s.massDamping = r.requireNonNegative("mass_damping", *a);
+    if (auto b = r.number("stiffness_damping")) {
+      s.stiffnessDamping = r.requireNonNegative("stiffness_damping", *b);
+    }
+    if (auto n = r.integer("max_newton_iterations")) {
+      if (*n < 1 || *n > 1000) {
+        r.fail("max_newton_iterations", "must be in [1, 1000] (got " + std::to_string(*n) + ")");
+      }
+      s.maxNewtonIterations = static_cast<int>(*n);
+    }
+  }
+
+  std::string file_;
+  std::string baseDir_;
+  toml::table root_;
+  SceneSpec spec_;
+};
+
+}  // namespace
+
+std::string resolveScenePath(const std::string& sceneOrFolder) {
+  std::error_code ec;
+  fs::path p(sceneOrFolder);
+  if (fs::is_directory(p, ec)) p /= "scene.toml";
+  if (!fs::exists(p, ec)) throw InputError(p.string(), "no such file");
+  if (!fs::is_regular_file(p, ec)) throw InputError(p.string(), "not a regular file");
+  return p.string();
+}
+
+void checkAnimationNodes(const SceneSpec& scene, const AnimationScene& animation) {
+  // Re-throw the animation's error at the scene line that named the node.
+  auto check = [&](long line, const std::string& key, auto&& probe) {
+    try {
+      probe();
+    } catch (const InputError& e) {
+      throw InputError(scene.file, line, key, e.what());
+    }
+  };
+  for (std::size_t i = 0; i < scene.handles.size(); ++i) {
+    const HandleSpec& h = scene.handles[i];
+    check(h.nodeLine, "handles[" + std::to_string(i) + "].node",
+          [&] { (void)animation.worldPose(h.node, 0.0); });
+  }
+  if (!scene.camera.node.empty()) {
+    check(scene.camera.nodeLine, "camera.node", [&] {
+      if (!animation.camera(scene.camera.node, 0.0)) {
+        throw InputError(animation.file(), "node '" + scene.camera.node + "' holds no camera");
+      }
+    });
+  }
+  if (scene.sheet.kind == SheetSpec::Kind::PatternMesh) {
+    check(scene.sheet.patternMeshLine, "sheet.pattern_mesh", [&] {
+      const std::optional<ImportedMesh> m = animation.mesh(scene.sheet.patternMesh);
+      if (!m || m->triangles.empty()) {
+        throw InputError(animation.file(),
+                         "node '" + scene.sheet.patternMesh + "' holds no triangle mesh");
+      }
+    });
+  }
+}
+
+SceneSpec loadScene(const std::string& path) {
+  const std::string file = resolveScenePath(path);
+  const std::string text = detail::readTextFile(file);
+  std::string dir = fs::path(file).parent_path().string();
+  if (dir.empty()) dir = ".";
+  return parseScene(text, file, dir);
+}
+
+SceneSpec parseScene(std::string_view text, const std::string& sourceName,
+                     const std::string& baseDir) {
+  return SceneParser(text, sourceName, baseDir).parse();
+}
+
+}  // namespace crumple::io

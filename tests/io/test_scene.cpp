@@ -1,0 +1,483 @@
+// The scene file parser: values, unit conversion, and one clear error (file,
+// line, key) for every bad input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "crumple/core/error.hpp"
+#include "crumple/io/animation.hpp"
+#include "crumple/io/scene.hpp"
+
+namespace crumple::io {
+namespace {
+
+const std::string kData = CRUMPLE_IO_TEST_DATA;
+constexpr double kPi = 3.14159265358979323846;
+
+SceneSpec parse(const std::string& text) { return parseScene(text, "test.toml", kData); }
+
+// Parsing `text` must throw InputError whose message starts with
+// "test.toml:LINE: 'KEY': " and contains every fragment.
+void expectError(const std::string& text, long line, const std::string& key,
+                 std::initializer_list<std::string> fragments = {}) {
+  try {
+    parse(text);
+    ADD_FAILURE() << "expected InputError for:\n" << text;
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    const std::string prefix = "test.toml:" + std::to_string(line) + ": '" + key + "': ";
+    EXPECT_EQ(msg.rfind(prefix, 0), 0u) << "message: " << msg << "\nexpected prefix: " << prefix;
+    for (const std::string& f : fragments) EXPECT_NE(msg.find(f), std::string::npos) << msg;
+  }
+}
+
+const std::string kSheet = "[sheet]\nwidth = 21\nheight = 29.7\n";
+
+TEST(Scene, FullSceneRoundTripsInCentimetres) {
+  const std::string text = R"(# every key
+[scene]
+name = "drape"
+units = "cm"
+fps = 30
+frames = [5, 60]
+substeps = 8
+seed = 42
+animation = "anim.gltf"
+
+[sheet]
+width = 21
+height = 29.7
+max_edge = 1.5
+origin = [1, 2, 3]
+u_axis = [2, 0, 0]
+v_axis = [0, 0, -1]
+
+[paper]
+preset = "office-90gsm"
+front_color = [0.9, 0.8, 0.7]
+back_color = [0.5, 0.5, 0.5]
+
+[[handles]]
+name = "left"
+node = "Handle"
+pattern = [0, 29.7]
+tangent_control = true
+tangent_vertices = 3
+release_time = 1.5
+
+[[handles]]
+node = "Child"
+
+[camera]
+position = [0, 30, 60]
+look_at = [0, 0, 0]
+up = [0, 1, 0]
+fov_deg = 50
+resolution = [320, 240]
+
+[[lights]]
+name = "sun"
+type = "directional"
+direction = [0, -2, 0]
+color = [1, 0.9, 0.8]
+intensity = 2
+shadow = true
+
+[[lights]]
+name = "bulb"
+type = "point"
+position = [10, 20, 30]
+
+[ground]
+height = -1
+size = 200
+color = [0.2, 0.3, 0.4]
+
+[output]
+dir = "out/custom"
+frames = false
+
+[sim]
+gravity = [0, -1.62, 0]
+mass_damping = 0.25
+stiffness_damping = 0.001
+max_newton_iterations = 12
+)";
+  const SceneSpec s = parse(text);
+  EXPECT_EQ(s.file, "test.toml");
+  EXPECT_EQ(s.dir, kData);
+  EXPECT_EQ(s.sourceText, text);
+  EXPECT_EQ(s.name, "drape");
+  EXPECT_DOUBLE_EQ(s.metresPerUnit, 0.01);
+  EXPECT_DOUBLE_EQ(s.fps, 30.0);
+  EXPECT_EQ(s.frameStart, 5);
+  EXPECT_EQ(s.frameEnd, 60);
+  EXPECT_EQ(s.substeps, 8);
+  EXPECT_EQ(s.seed, 42u);
+  EXPECT_EQ(s.animationFile, kData + "/anim.gltf");
+  EXPECT_DOUBLE_EQ(s.frameTime(48), 1.6);
+
+  EXPECT_EQ(s.sheet.kind, SheetSpec::Kind::Rectangle);
+  EXPECT_NEAR(s.sheet.width, 0.21, 1e-15);
+  EXPECT_NEAR(s.sheet.height, 0.297, 1e-15);
+  EXPECT_NEAR(s.sheet.maxEdge, 0.015, 1e-15);
+  EXPECT_TRUE(s.sheet.origin.isApprox(Vec3(0.01, 0.02, 0.03)));
+  EXPECT_TRUE(s.sheet.uAxis.isApprox(Vec3(1, 0, 0)));  // normalised, not scaled
+  EXPECT_TRUE(s.sheet.vAxis.isApprox(Vec3(0, 0, -1)));
+
+  EXPECT_EQ(s.paperPreset, "office-90gsm");
+  EXPECT_EQ(s.paper.name, "office-90gsm");
+  EXPECT_NEAR(s.paper.grammage, 0.090, 1e-12);
+  EXPECT_TRUE(s.paper.frontColor.isApprox(Vec3(0.9, 0.8, 0.7)));
+  EXPECT_TRUE(s.paper.backColor.isApprox(Vec3(0.5, 0.5, 0.5)));
+
+  ASSERT_EQ(s.handles.size(), 2u);
+  EXPECT_EQ(s.handles[0].name, "left");
+  EXPECT_EQ(s.handles[0].node, "Handle");
+  ASSERT_TRUE(s.handles[0].patternPoint.has_value());
+  EXPECT_TRUE(s.handles[0].patternPoint->isApprox(Vec2(0, 0.297)));
+  EXPECT_TRUE(s.handles[0].tangentControl);
+  EXPECT_EQ(s.handles[0].tangentVertices, 3);
+  ASSERT_TRUE(s.handles[0].releaseTime.has_value());
+  EXPECT_DOUBLE_EQ(*s.handles[0].releaseTime, 1.5);  // seconds, not scaled
+  EXPECT_EQ(s.handles[1].name, "Child");             // defaults to the node
+  EXPECT_FALSE(s.handles[1].patternPoint.has_value());
+  EXPECT_FALSE(s.handles[1].tangentControl);
+  EXPECT_FALSE(s.handles[1].releaseTime.has_value());
+
+  EXPECT_TRUE(s.camera.node.empty());
+  EXPECT_TRUE(s.camera.position.isApprox(Vec3(0, 0.3, 0.6)));
+  EXPECT_TRUE(s.camera.lookAt.isZero());
+  EXPECT_NEAR(s.camera.yfov, 50.0 * kPi / 180.0, 1e-15);
+  EXPECT_TRUE(s.camera.fovExplicit);
+  EXPECT_EQ(s.camera.width, 320);
+  EXPECT_EQ(s.camera.height, 240);
+
+  ASSERT_EQ(s.lights.size(), 2u);
+  EXPECT_EQ(s.lights[0].name, "sun");
+  EXPECT_EQ(s.lights[0].kind, LightSpec::Kind::Directional);
+  EXPECT_TRUE(s.lights[0].direction.isApprox(Vec3(0, -1, 0)));
+  EXPECT_TRUE(s.lights[0].color.isApprox(Vec3(1, 0.9, 0.8)));
+  EXPECT_DOUBLE_EQ(s.lights[0].intensity, 2.0);
+  EXPECT_TRUE(s.lights[0].shadow);
+  EXPECT_EQ(s.lights[1].kind, LightSpec::Kind::Point);
+  EXPECT_TRUE(s.lights[1].position.isApprox(Vec3(0.1, 0.2, 0.3)));
+  EXPECT_FALSE(s.lights[1].shadow);
+
+  EXPECT_TRUE(s.ground.enabled);  // the table's presence enables it
+  EXPECT_NEAR(s.ground.height, -0.01, 1e-15);
+  EXPECT_NEAR(s.ground.size, 2.0, 1e-15);
+  EXPECT_TRUE(s.ground.color.isApprox(Vec3(0.2, 0.3, 0.4)));
+
+  EXPECT_EQ(s.output.dir, "out/custom");
+  EXPECT_FALSE(s.output.frames);
+
+  EXPECT_TRUE(s.sim.gravity.isApprox(Vec3(0, -1.62, 0)));  // m/s^2, never scaled by units
+  EXPECT_DOUBLE_EQ(s.sim.massDamping, 0.25);
+  EXPECT_DOUBLE_EQ(s.sim.stiffnessDamping, 0.001);
+  EXPECT_EQ(s.sim.maxNewtonIterations, 12);
+}
+
+TEST(Scene, Defaults) {
+  const SceneSpec s = parse("[sheet]\nwidth = 0.2\nheight = 0.3\n");
+  EXPECT_EQ(s.name, std::filesystem::path(kData).filename().string());  // folder name
+  EXPECT_DOUBLE_EQ(s.metresPerUnit, 1.0);
+  EXPECT_DOUBLE_EQ(s.sheet.width, 0.2);
+  EXPECT_DOUBLE_EQ(s.sheet.maxEdge, 0.0);
+  EXPECT_DOUBLE_EQ(s.fps, 24.0);
+  EXPECT_EQ(s.frameStart, 1);
+  EXPECT_EQ(s.frameEnd, 48);
+  EXPECT_EQ(s.substeps, 4);
+  EXPECT_TRUE(s.animationFile.empty());
+  EXPECT_EQ(s.paper.name, "office-70gsm");
+  EXPECT_TRUE(s.handles.empty());
+  EXPECT_FALSE(s.camera.fovExplicit);
+  EXPECT_FALSE(s.ground.enabled);
+  ASSERT_EQ(s.lights.size(), 2u);
+  EXPECT_EQ(s.lights[0].name, "key");
+  EXPECT_TRUE(s.lights[0].shadow);
+  EXPECT_DOUBLE_EQ(s.lights[0].intensity, 1.0);
+  EXPECT_NEAR(s.lights[0].direction.norm(), 1.0, 1e-12);
+  EXPECT_EQ(s.lights[1].name, "fill");
+  EXPECT_FALSE(s.lights[1].shadow);
+  EXPECT_DOUBLE_EQ(s.lights[1].intensity, 0.35);
+}
+
+TEST(Scene, OtherUnits) {
+  const SceneSpec mm = parse("[scene]\nunits = \"mm\"\n[sheet]\nwidth = 210\nheight = 297\n");
+  EXPECT_NEAR(mm.sheet.width, 0.21, 1e-15);
+  const SceneSpec in = parse("[scene]\nunits = \"in\"\n[sheet]\nwidth = 8.5\nheight = 11\n");
+  EXPECT_NEAR(in.sheet.width, 0.2159, 1e-15);
+  EXPECT_NEAR(in.sheet.height, 0.2794, 1e-15);
+}
+
+TEST(Scene, CameraFromFocalLength) {
+  const SceneSpec s =
+      parse(kSheet + "[camera]\nfocal_mm = 50\nsensor_mm = 36\nresolution = [600, 400]\n");
+  // Sensor width 36 mm, aspect 1.5: sensor height 24 mm.
+  EXPECT_NEAR(s.camera.yfov, 2.0 * std::atan(12.0 / 50.0), 1e-15);
+  const SceneSpec d = parse(kSheet + "[camera]\nfocal_mm = 35\nresolution = [600, 400]\n");
+  EXPECT_NEAR(d.camera.yfov, 2.0 * std::atan(12.0 / 35.0), 1e-15);  // default sensor 36 mm
+}
+
+TEST(Scene, CameraNodeAndPatternMesh) {
+  const SceneSpec s = parse(
+      "[scene]\nanimation = \"anim.glb\"\n[sheet]\npattern_mesh = \"Sheet\"\nmax_edge = 0.01\n"
+      "[camera]\nnode = \"Camera\"\n");
+  EXPECT_EQ(s.sheet.kind, SheetSpec::Kind::PatternMesh);
+  EXPECT_EQ(s.sheet.patternMesh, "Sheet");
+  EXPECT_EQ(s.camera.node, "Camera");
+  EXPECT_FALSE(s.camera.fovExplicit);
+}
+
+TEST(Scene, LoadFromFolder) {
+  const std::string folder = kData + "/drape";
+  EXPECT_EQ(resolveScenePath(folder), folder + "/scene.toml");
+  EXPECT_EQ(resolveScenePath(folder + "/scene.toml"), folder + "/scene.toml");
+  const SceneSpec s = loadScene(folder);
+  EXPECT_EQ(s.name, "drape");
+  EXPECT_EQ(s.file, folder + "/scene.toml");
+  EXPECT_EQ(s.dir, folder);
+  EXPECT_EQ(s.animationFile, kData + "/anim.gltf");  // ../ resolved against the scene folder
+  std::ifstream in(folder + "/scene.toml");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(s.sourceText, text);
+  ASSERT_EQ(s.handles.size(), 1u);
+  EXPECT_TRUE(s.handles[0].patternPoint->isApprox(Vec2(0, 0.297)));
+}
+
+TEST(Scene, MissingSceneFile) {
+  try {
+    resolveScenePath(kData + "/nowhere");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), kData + "/nowhere: no such file");
+  }
+  try {
+    loadScene(kData);  // a folder without scene.toml
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), kData + "/scene.toml: no such file");
+  }
+}
+
+// ---- One error per bad input ---------------------------------------------------
+
+TEST(SceneErrors, TomlSyntax) {
+  try {
+    parse("[scene]\nfps = 24\nname = \"unterminated\n");
+    FAIL();
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind("test.toml:3:", 0), 0u) << msg;
+    EXPECT_NE(msg.find("TOML syntax error"), std::string::npos) << msg;
+  }
+}
+
+TEST(SceneErrors, UnknownTableAndKeys) {
+  expectError(kSheet + "[extras]\nx = 1\n", 4, "extras", {"unknown key"});
+  expectError("[scene]\nfps = 24\nbogus = 3\n" + kSheet, 3, "scene.bogus",
+              {"unknown key", "expected one of", "fps"});
+  expectError(kSheet + "colour = 3\n", 4, "sheet.colour", {"unknown key"});
+  expectError(kSheet + "[[handles]]\nnode = \"Handle\"\nwhatever = 1\n", 6, "handles[0].whatever",
+              {"unknown key"});
+  expectError(kSheet + "[camera]\n[camera.lens]\nf = 1\n", 5, "camera.lens", {"unknown key"});
+  expectError(kSheet + "[sim]\ngravity = [0, -9.8, 0]\nsolver = \"cg\"\n", 6, "sim.solver");
+}
+
+TEST(SceneErrors, WrongTypes) {
+  expectError("[scene]\nfps = \"24\"\n" + kSheet, 2, "scene.fps", {"expected a number", "string"});
+  expectError("[scene]\nsubsteps = 2.5\n" + kSheet, 2, "scene.substeps", {"expected an integer"});
+  expectError("[scene]\nframes = [1.0, 2]\n" + kSheet, 2, "scene.frames", {"two integers"});
+  expectError(kSheet + "origin = [1, 2]\n", 4, "sheet.origin", {"3 numbers", "2 elements"});
+  expectError(kSheet + "origin = [1, \"a\", 2]\n", 4, "sheet.origin", {"element 1"});
+  expectError(kSheet + "[ground]\nenabled = 1\n", 5, "ground.enabled", {"true or false"});
+  expectError("[scene]\nname = 3\n" + kSheet, 2, "scene.name", {"expected a string"});
+  expectError("sheet = 3\n", 1, "sheet", {"expected a table"});
+  expectError(kSheet + "[handles]\nnode = \"Handle\"\n", 4, "handles", {"array of tables"});
+}
+
+TEST(SceneErrors, BadSizes) {
+  expectError("[sheet]\nwidth = -21\nheight = 29.7\n", 2, "sheet.width", {"must be > 0", "-21"});
+  expectError("[sheet]\nwidth = 21\nheight = 0\n", 3, "sheet.height", {"must be > 0"});
+  expectError(kSheet + "max_edge = 0\n", 4, "sheet.max_edge", {"must be > 0"});
+  expectError(kSheet + "max_edge = 100\n", 4, "sheet.max_edge", {"larger than the sheet"});
+  expectError(kSheet + "[ground]\nsize = -2\n", 5, "ground.size", {"must be > 0"});
+}
+
+TEST(SceneErrors, MissingRequiredKeyUsesTableLine) {
+  expectError("[scene]\nfps = 24\n\n[sheet]\nwidth = 21\n", 4, "sheet.height",
+              {"missing required key"});
+  expectError(kSheet + "\n[[handles]]\nname = \"a\"\n", 5, "handles[0].node",
+              {"missing required key"});
+  expectError(kSheet + "[[lights]]\ntype = \"point\"\n", 4, "lights[0].position",
+              {"missing required key"});
+}
+
+TEST(SceneErrors, MissingSheetTable) {
+  try {
+    parse("[scene]\nfps = 24\n");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "test.toml: 'sheet': missing required table [sheet]");
+  }
+}
+
+TEST(SceneErrors, SceneValues) {
+  expectError("[scene]\nfps = 0\n" + kSheet, 2, "scene.fps", {"must be > 0"});
+  expectError("[scene]\nfps = -24\n" + kSheet, 2, "scene.fps", {"must be > 0"});
+  expectError("[scene]\nframes = [48, 1]\n" + kSheet, 2, "scene.frames",
+              {"first frame 48 is after last frame 1"});
+  expectError("[scene]\nsubsteps = 0\n" + kSheet, 2, "scene.substeps", {"[1, 1024]"});
+  expectError("[scene]\nsubsteps = 1025\n" + kSheet, 2, "scene.substeps", {"[1, 1024]"});
+  expectError("[scene]\nunits = \"furlong\"\n" + kSheet, 2, "scene.units",
+              {"unknown unit 'furlong'", "m, cm, mm, in"});
+  expectError("[scene]\nseed = -1\n" + kSheet, 2, "scene.seed", {">= 0"});
+  expectError("[scene]\nname = \"\"\n" + kSheet, 2, "scene.name", {"empty"});
+  expectError("[scene]\nanimation = \"nope.glb\"\n" + kSheet, 2, "scene.animation",
+              {"no such file", "nope.glb"});
+}
+
+TEST(SceneErrors, NonFiniteNumbers) {
+  expectError("[sheet]\nwidth = nan\nheight = 1\n", 2, "sheet.width", {"finite"});
+  expectError("[scene]\nfps = inf\n" + kSheet, 2, "scene.fps", {"finite"});
+  expectError(kSheet + "origin = [0, -inf, 0]\n", 4, "sheet.origin", {"finite"});
+}
+
+TEST(SceneErrors, SheetShape) {
+  expectError(
+      "[scene]\nanimation = \"anim.gltf\"\n[sheet]\nwidth = 21\nheight = 29.7\n"
+      "pattern_mesh = \"Sheet\"\n",
+      4, "sheet.width", {"either width/height or pattern_mesh"});
+  expectError("[sheet]\npattern_mesh = \"Sheet\"\n", 2, "sheet.pattern_mesh",
+              {"needs an animation file"});
+  expectError(
+      "[scene]\nanimation = \"anim.gltf\"\n[sheet]\npattern_mesh = \"Sheet\"\n"
+      "origin = [0, 0, 0]\n",
+      5, "sheet.origin", {"only for a width/height rectangle"});
+  expectError(kSheet + "u_axis = [0, 0, 0]\n", 4, "sheet.u_axis", {"non-zero"});
+  expectError(kSheet + "v_axis = [1, 1, 0]\n", 4, "sheet.v_axis", {"perpendicular"});
+}
+
+const std::string kAnimSheet = "[scene]\nanimation = \"anim.gltf\"\n" + kSheet;  // lines 1-5
+
+TEST(SceneErrors, Handles) {
+  expectError(kAnimSheet +
+                  "[[handles]]\nnode = \"Handle\"\ntangent_control = true\n"
+                  "tangent_vertices = 1\n",
+              9, "handles[0].tangent_vertices", {"0 (automatic) or 2, 3 or 4"});
+  expectError(kAnimSheet +
+                  "[[handles]]\nnode = \"Handle\"\ntangent_control = true\n"
+                  "tangent_vertices = 5\n",
+              9, "handles[0].tangent_vertices");
+  expectError(kAnimSheet + "[[handles]]\nnode = \"Handle\"\ntangent_vertices = 3\n", 8,
+              "handles[0].tangent_vertices", {"needs tangent_control = true"});
+  expectError(kAnimSheet + "[[handles]]\nnode = \"Handle\"\n[[handles]]\nnode = \"Handle\"\n", 9,
+              "handles[1].node", {"duplicate handle name 'Handle'"});
+  expectError(kAnimSheet +
+                  "[[handles]]\nname = \"a\"\nnode = \"Handle\"\n"
+                  "[[handles]]\nname = \"a\"\nnode = \"Child\"\n",
+              10, "handles[1].name", {"duplicate handle name 'a'"});
+  expectError(kAnimSheet + "[[handles]]\nnode = \"Handle\"\npattern = [21.5, 3]\n", 8,
+              "handles[0].pattern", {"outside the sheet", "[0, 21] x [0, 29.7]"});
+  expectError(kAnimSheet + "[[handles]]\nnode = \"Handle\"\npattern = [3, -0.1]\n", 8,
+              "handles[0].pattern", {"outside the sheet"});
+  expectError(kAnimSheet + "[[handles]]\nnode = \"Handle\"\nrelease_time = -1\n", 8,
+              "handles[0].release_time", {">= 0"});
+  expectError(kSheet + "[[handles]]\nnode = \"Handle\"\n", 5, "handles[0].node",
+              {"need an animation file"});
+}
+
+TEST(SceneErrors, Paper) {
+  expectError(kSheet + "[paper]\npreset = \"papyrus\"\n", 5, "paper.preset",
+              {"unknown paper preset 'papyrus'", "office-70gsm", "office-90gsm"});
+  expectError(kSheet + "[paper]\npreset = \"../papers/office-70gsm\"\n", 5, "paper.preset",
+              {"not a path"});
+  expectError(kSheet + "[paper]\nfront_color = [1.2, 0, 0]\n", 5, "paper.front_color",
+              {"component 0", "[0, 1]"});
+}
+
+TEST(SceneErrors, Camera) {
+  expectError(kAnimSheet + "[camera]\nnode = \"Camera\"\nposition = [0, 1, 2]\n", 8,
+              "camera.position", {"either node or position"});
+  expectError(kSheet + "[camera]\nfov_deg = 40\nfocal_mm = 35\n", 6, "camera.focal_mm",
+              {"either fov_deg or focal_mm"});
+  expectError(kSheet + "[camera]\nfov_deg = 180\n", 5, "camera.fov_deg", {"(0, 180)"});
+  expectError(kSheet + "[camera]\nsensor_mm = 36\n", 5, "camera.sensor_mm", {"needs focal_mm"});
+  expectError(kSheet + "[camera]\nfocal_mm = -35\n", 5, "camera.focal_mm", {"> 0"});
+  expectError(kSheet + "[camera]\nresolution = [0, 480]\n", 5, "camera.resolution", {"[1, 16384]"});
+  expectError(kSheet + "[camera]\nposition = [0, 0, 0]\nlook_at = [0, 0, 0]\n", 6, "camera.look_at",
+              {"must differ from position"});
+  expectError(kSheet + "[camera]\nposition = [0, 1, 0]\nup = [0, 2, 0]\n", 6, "camera.up",
+              {"parallel"});
+  expectError(kSheet + "[camera]\nnode = \"Camera\"\n", 5, "camera.node",
+              {"needs an animation file"});
+}
+
+TEST(SceneErrors, Lights) {
+  expectError(kSheet + "[[lights]]\ntype = \"spot\"\n", 5, "lights[0].type",
+              {"unknown light type 'spot'"});
+  expectError(kSheet + "[[lights]]\nposition = [0, 1, 0]\n", 5, "lights[0].position",
+              {"only for point lights"});
+  expectError(
+      kSheet + "[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n", 7,
+      "lights[0].direction", {"only for directional lights"});
+  expectError(kSheet + "[[lights]]\nintensity = -1\n", 5, "lights[0].intensity", {">= 0"});
+  expectError(kSheet + "[[lights]]\nname = \"a\"\n[[lights]]\nname = \"a\"\n", 7, "lights[1].name",
+              {"duplicate light name 'a'"});
+  expectError(kSheet + "[[lights]]\ndirection = [0, 0, 0]\n", 5, "lights[0].direction",
+              {"non-zero"});
+}
+
+TEST(SceneErrors, Sim) {
+  expectError(kSheet + "[sim]\nmass_damping = -0.5\n", 5, "sim.mass_damping", {">= 0"});
+  expectError(kSheet + "[sim]\nmax_newton_iterations = 0\n", 5, "sim.max_newton_iterations",
+              {"[1, 1000]"});
+}
+
+TEST(SceneAnimation, NodesAreCheckedAgainstTheFile) {
+  const std::string good = R"([scene]
+animation = "anim.glb"
+[sheet]
+pattern_mesh = "Sheet"
+[camera]
+node = "Camera"
+[[handles]]
+node = "Handle"
+[[handles]]
+node = "Child"
+)";
+  const SceneSpec s = parse(good);
+  EXPECT_EQ(s.handles[1].nodeLine, 10);
+  const AnimationScene anim = AnimationScene::load(s.animationFile);
+  EXPECT_NO_THROW(checkAnimationNodes(s, anim));
+
+  auto expectCheckError = [&](const std::string& text, const std::string& prefix,
+                              const std::string& fragment) {
+    const SceneSpec bad = parse(text);
+    try {
+      checkAnimationNodes(bad, anim);
+      ADD_FAILURE() << text;
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind(prefix, 0), 0u) << msg;
+      EXPECT_NE(msg.find(fragment), std::string::npos) << msg;
+      EXPECT_NE(msg.find("anim.glb"), std::string::npos) << msg;
+    }
+  };
+  std::string text = good;
+  expectCheckError(text.replace(text.find("\"Child\""), 7, "\"Thumb\""),
+                   "test.toml:10: 'handles[1].node': ", "no node named 'Thumb'");
+  text = good;
+  expectCheckError(text.replace(text.find("\"Camera\""), 8, "\"Static\""),
+                   "test.toml:6: 'camera.node': ", "holds no camera");
+  text = good;
+  expectCheckError(text.replace(text.find("\"Sheet\""), 7, "\"Handle\""),
+                   "test.toml:4: 'sheet.pattern_mesh': ", "holds no triangle mesh");
+}
+
+}  // namespace
+}  // namespace crumple::io
