@@ -2,6 +2,33 @@
 // The OSMesa preview rasteriser: the scene camera, a key light with a shadow
 // map, fill lights, the two-sided paper with its pattern texture, a ground
 // plane. Deterministic: identical input gives identical bytes.
+//
+// Output (ImageRGBA8): rows top to bottom, sRGB-encoded colour, straight
+// alpha. Alpha is coverage by paper or ground: 255 where covered, 0 for the
+// background (whose RGB is scene.background encoded to sRGB), in between on
+// antialiased silhouettes (4x MSAA) whose RGB is the covered samples' colour.
+//
+// Shading: Lambert, colour = albedo * (0.25 * background + sum of lights).
+// A directional light contributes color * intensity * max(0, n.l); a point
+// light color * intensity / d^2 * max(0, n.l). An empty light list means one
+// default Light{} (directional, no shadow). At most 16 lights. The key light
+// (first with shadow == true) casts the paper's shadow on the ground and on
+// the paper itself (shadow map, orthographic and fitted to the paper for a
+// directional light, perspective for a point light; PCF; slope-scaled bias).
+// Paper albedo = texture * frontColor on the front (3D winding counter-
+// clockwise as in the pattern) and texture * backColor on the back; the
+// texture's top row is at pattern y = textureSize.y, so seen from the front
+// with the pattern's +y up the image is upright and not mirrored; it repeats
+// beyond textureSize.
+//
+// Determinism: byte-identical across runs, processes, renderer instances and
+// LP_NUM_THREADS. The first renderer of a process sets
+// GALLIUM_OVERRIDE_CPU_CAPS=sse4.1 (unless already set) so that llvmpipe
+// does not use AVX/FMA and images also match across x86-64 machines with the
+// same Mesa/LLVM; set it to another value (e.g. "native") beforehand to opt out.
+//
+// Threads: one render() at a time per renderer; render() binds the context to
+// the calling thread and releases it, so renderers may live in several threads.
 #include <memory>
 
 #include "crumple/core/image.hpp"
@@ -20,7 +47,9 @@ class OsmesaRenderer {
   OsmesaRenderer& operator=(const OsmesaRenderer&) = delete;
 
   // Draws the sheet (positions, triangles, pattern as texture coordinates).
-  // The camera's width/height must match the renderer's.
+  // The camera's width/height must match the renderer's. Throws
+  // std::invalid_argument on inconsistent or non-finite input and
+  // std::runtime_error on a GL failure.
   ImageRGBA8 render(const RenderScene& scene, const mesh::SheetMesh& sheet);
 
  private:

@@ -1,6 +1,8 @@
 #pragma once
 // What a renderer needs to draw one frame: camera, lights, ground, the paper's
 // look. Shared by the OSMesa preview (and later the Embree path tracer).
+#include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "crumple/core/image.hpp"
@@ -17,7 +19,9 @@ struct Camera {
   int width = 640;
   int height = 480;
 
-  // A camera at `position` looking at `target`.
+  // A camera at `position` looking at `target`, `up` projecting upwards in the
+  // image. An `up` parallel to the view direction is replaced by the world axis
+  // least aligned with it. Throws std::invalid_argument if target == position.
   static Camera lookAt(const Vec3& position, const Vec3& target, const Vec3& up, double yfov,
                        int width, int height);
 };
@@ -58,7 +62,29 @@ struct RenderScene {
 };
 
 // A deterministic ruled-notebook texture (lines and a margin) so orientation
-// and stretching are visible.
+// and stretching are visible: off-white paper, blue horizontal rules (0.7/297
+// of the height thick) every 8/297 of the height below a 30/297 header band,
+// a red vertical margin line (1/210 of the width) 30/210 of the width from the
+// left; lines box-filtered. Rows top to bottom, sRGB, alpha 255.
+// Throws std::invalid_argument unless width, height > 0.
 ImageRGBA8 makeRuledPaperTexture(int width, int height);
+
+// --- Camera math shared by the rasteriser, the path tracer and the tests ----
+// World -> camera transform (the inverse of the camera pose; the camera looks
+// down its local -Z with +Y up).
+Mat4 viewMatrix(const Camera& camera);
+// OpenGL-style perspective projection (clip space, NDC z in [-1, 1]) with
+// aspect = width / height.
+Mat4 projectionMatrix(const Camera& camera);
+// Where a world point lands in the image, in continuous pixel coordinates: x to
+// the right, y downwards (row 0 at the top), pixel (i, j) covering
+// [i, i+1) x [j, j+1). Empty when the point is not in front of the camera.
+std::optional<Vec2> projectToPixel(const Camera& camera, const Vec3& world);
+
+// Linear [0, 1] -> 8-bit sRGB (clamped), the exact piecewise sRGB curve,
+// rounded to nearest. The renderer encodes the background with it.
+std::uint8_t linearToSrgb8(double linear);
+// 8-bit sRGB -> linear [0, 1].
+double srgb8ToLinear(std::uint8_t srgb);
 
 }  // namespace crumple::render

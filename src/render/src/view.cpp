@@ -1,0 +1,140 @@
+#include "crumple/render/view.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace crumple::render {
+
+Camera Camera::lookAt(const Vec3& position, const Vec3& target, const Vec3& up, double yfov,
+                      int width, int height) {
+  Camera c;
+  c.position = position;
+  c.yfov = yfov;
+  c.width = width;
+  c.height = height;
+  const Vec3 toTarget = target - position;
+  if (!(toTarget.norm() > 0.0) || !toTarget.allFinite())
+    throw std::invalid_argument("Camera::lookAt: target must differ from position");
+  const Vec3 forward = toTarget.normalized();
+  Vec3 right = forward.cross(up);
+  if (!(right.norm() > 1e-12 * std::max(1.0, up.norm()))) {
+    // `up` is parallel to the view direction: pick the world axis least
+    // aligned with it so the result stays well defined.
+    const Vec3 a = forward.cwiseAbs();
+    const Vec3 alt = (a.x() <= a.y() && a.x() <= a.z()) ? Vec3::UnitX()
+                     : (a.y() <= a.z())                 ? Vec3::UnitY()
+                                                        : Vec3::UnitZ();
+    right = forward.cross(alt);
+  }
+  right.normalize();
+  const Vec3 trueUp = right.cross(forward);
+  Mat3 r;
+  r.col(0) = right;
+  r.col(1) = trueUp;
+  r.col(2) = -forward;
+  c.rotation = Quat(r).normalized();
+  return c;
+}
+
+namespace {
+
+// Length of [a0, a1] ∩ [b0, b1].
+double overlap(double a0, double a1, double b0, double b1) {
+  return std::max(0.0, std::min(a1, b1) - std::max(a0, b0));
+}
+
+}  // namespace
+
+ImageRGBA8 makeRuledPaperTexture(int width, int height) {
+  if (width <= 0 || height <= 0)
+    throw std::invalid_argument("makeRuledPaperTexture: width and height must be positive");
+  const double w = width, h = height;
+  // Proportions of an A4 ruled sheet (mm) scaled to the texture; the lines are
+  // bolder than real ones (0.7 mm, 1 mm) so they survive preview resolutions.
+  const double ruleSpacing = h * 8.0 / 297.0;
+  const double firstRule = h * 30.0 / 297.0;
+  const double ruleThickness = std::max(1.0, h * 0.7 / 297.0);
+  const double marginX = w * 30.0 / 210.0;
+  const double marginThickness = std::max(1.0, w * 1.0 / 210.0);
+
+  const Vec3 paper(srgb8ToLinear(252), srgb8ToLinear(251), srgb8ToLinear(246));
+  const Vec3 rule(srgb8ToLinear(110), srgb8ToLinear(150), srgb8ToLinear(215));
+  const Vec3 margin(srgb8ToLinear(220), srgb8ToLinear(70), srgb8ToLinear(80));
+
+  // Box-filtered coverage of the rules per row and of the margin per column.
+  std::vector<double> rowCover(static_cast<std::size_t>(height), 0.0);
+  for (int k = 0;; ++k) {
+    const double c = firstRule + k * ruleSpacing;
+    if (c > h - 0.5 * ruleSpacing) break;
+    const double lo = c - 0.5 * ruleThickness, hi = c + 0.5 * ruleThickness;
+    const int y0 = std::max(0, static_cast<int>(std::floor(lo)));
+    const int y1 = std::min(height - 1, static_cast<int>(std::floor(hi)));
+    for (int y = y0; y <= y1; ++y)
+      rowCover[static_cast<std::size_t>(y)] =
+          std::min(1.0, rowCover[static_cast<std::size_t>(y)] + overlap(y, y + 1.0, lo, hi));
+  }
+  std::vector<double> colCover(static_cast<std::size_t>(width), 0.0);
+  {
+    const double lo = marginX - 0.5 * marginThickness, hi = marginX + 0.5 * marginThickness;
+    for (int x = 0; x < width; ++x)
+      colCover[static_cast<std::size_t>(x)] = std::min(1.0, overlap(x, x + 1.0, lo, hi));
+  }
+
+  ImageRGBA8 img(width, height);
+  for (int y = 0; y < height; ++y) {
+    const double ry = rowCover[static_cast<std::size_t>(y)];
+    const Vec3 rowColor = (1.0 - ry) * paper + ry * rule;
+    for (int x = 0; x < width; ++x) {
+      const double mx = colCover[static_cast<std::size_t>(x)];
+      const Vec3 c = (1.0 - mx) * rowColor + mx * margin;
+      std::uint8_t* p = img.at(x, y);
+      p[0] = linearToSrgb8(c.x());
+      p[1] = linearToSrgb8(c.y());
+      p[2] = linearToSrgb8(c.z());
+      p[3] = 255;
+    }
+  }
+  return img;
+}
+
+Mat4 viewMatrix(const Camera& camera) {
+  const Mat3 r = camera.rotation.normalized().toRotationMatrix();
+  Mat4 v = Mat4::Identity();
+  v.topLeftCorner<3, 3>() = r.transpose();
+  v.topRightCorner<3, 1>() = -(r.transpose() * camera.position);
+  return v;
+}
+
+Mat4 projectionMatrix(const Camera& camera) {
+  const double aspect = static_cast<double>(camera.width) / static_cast<double>(camera.height);
+  const double f = 1.0 / std::tan(0.5 * camera.yfov);
+  const double n = camera.znear, fa = camera.zfar;
+  Mat4 p = Mat4::Zero();
+  p(0, 0) = f / aspect;
+  p(1, 1) = f;
+  p(2, 2) = (fa + n) / (n - fa);
+  p(2, 3) = 2.0 * fa * n / (n - fa);
+  p(3, 2) = -1.0;
+  return p;
+}
+
+std::optional<Vec2> projectToPixel(const Camera& camera, const Vec3& world) {
+  const Vec4 clip = projectionMatrix(camera) * (viewMatrix(camera) * world.homogeneous());
+  if (!(clip.w() > 0.0)) return std::nullopt;
+  const double nx = clip.x() / clip.w(), ny = clip.y() / clip.w();
+  return Vec2((nx * 0.5 + 0.5) * camera.width, (0.5 - ny * 0.5) * camera.height);
+}
+
+std::uint8_t linearToSrgb8(double linear) {
+  const double c = std::clamp(std::isnan(linear) ? 0.0 : linear, 0.0, 1.0);
+  const double s = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
+  return static_cast<std::uint8_t>(std::lround(std::clamp(s, 0.0, 1.0) * 255.0));
+}
+
+double srgb8ToLinear(std::uint8_t srgb) {
+  const double s = srgb / 255.0;
+  return s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4);
+}
+
+}  // namespace crumple::render
