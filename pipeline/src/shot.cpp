@@ -385,7 +385,8 @@ RenderReport renderCache(const std::string& cachePath, const RenderOptions& opti
   if (reader.frameCount() == 0) throw InputError(cachePath, "the cache holds no frames");
   const auto& header = reader.header();
   const io::SceneSpec scene = io::parseScene(header.sceneText, header.sceneFile + " (in " + cachePath + ")",
-                                             fs::path(header.sceneFile).parent_path().string());
+                                             fs::path(header.sceneFile).parent_path().string(),
+                                             /*checkFiles=*/false);
   RenderReport report;
   report.framesDir = !options.framesDir.empty()
                          ? options.framesDir

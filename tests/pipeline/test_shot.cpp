@@ -53,7 +53,7 @@ TEST(Shot, DrapeSampleFollowsItsHandlesAndStaysFinite) {
   auto options = quiet(tmp / "out", true);
   options.frames = pipeline::FrameRange{1, 24};
   const auto report = pipeline::runShot(scene, options);
-  EXPECT_EQ(report.framesSimulated, 24);
+  EXPECT_EQ(report.framesSimulated, 25) << "frames 0-24: simulation starts at the scene's first frame";
   EXPECT_EQ(report.framesRendered, 24);
   EXPECT_TRUE(fs::exists(tmp / "out/frames/0024.png"));
   const auto anim = io::AnimationScene::load(scene.animationFile);
@@ -78,23 +78,31 @@ TEST(Shot, HandlesTrackTheirCurvesForEveryFormat) {
     TempDir tmp;
     fs::create_directories(tmp / "s");
     std::string scene = smallSceneToml("", sourcePath(file));
-    // One handle on node "Handle", bound to the sheet point nearest to it.
+    // One handle on node "Handle" (at the origin at t = 0), bound to the
+    // sheet point nearest to it -- the middle of the top edge -- with
+    // tangent-plane control, so the node's rotation keys matter too.
     const auto first = scene.find("[[handles]]");
     const auto cameraAt = scene.find("[camera]");
-    scene = scene.substr(0, first) + "[[handles]]\nname = \"h\"\nnode = \"Handle\"\n" +
-            "[[handles]]\nname = \"c\"\nnode = \"Child\"\n" + scene.substr(cameraAt);
+    scene = scene.substr(0, first) +
+            "[[handles]]\nname = \"h\"\nnode = \"Handle\"\ntangent_control = true\n" +
+            scene.substr(cameraAt);
+    scene.replace(scene.find("origin = [-5.0, 10.0, 0.0]"), 26, "origin = [-5.0, -10.0, 0.0]");
     scene.replace(scene.find("frames = [1, 6]"), 15, "frames = [0, 48]");
     writeFile(tmp / "s/scene.toml", scene);
     const auto spec = io::loadScene((tmp / "s/scene.toml").string());
     const auto report = pipeline::runShot(spec, quiet(tmp / "out"));
     const auto anim = io::AnimationScene::load(spec.animationFile);
-    EXPECT_LT(maxHandleDeviation(report.cachePath, anim, {"Handle", "Child"}), 1e-6) << file;
+    EXPECT_LT(maxHandleDeviation(report.cachePath, anim, {"Handle"}), 1e-6) << file;
     const cache::CacheReader reader(report.cachePath);
+    // The tangent-plane vertices (3 on a border) follow the node's rotation.
+    const auto held = pipeline::tangentNeighbours(pipeline::buildSheet(spec, &anim),
+                                                  reader.readFrame(0).handleVertices[0], 0);
+    EXPECT_EQ(held.size(), 3u);
     std::vector<Vec3> traj;
     for (std::size_t i = 0; i < reader.frameCount(); ++i) {
       const auto frame = reader.readFrame(i);
-      for (std::size_t h = 0; h < 2; ++h)
-        traj.push_back(frame.positions[static_cast<std::size_t>(frame.handleVertices[h])]);
+      traj.push_back(frame.positions[static_cast<std::size_t>(frame.handleVertices[0])]);
+      for (int v : held) traj.push_back(frame.positions[static_cast<std::size_t>(v)]);
     }
     trajectories.push_back(traj);
   }

@@ -151,7 +151,10 @@ inline std::string makeGltf(const std::vector<GltfTrack>& tracks) {
                 std::to_string(i) + ",\"path\":\"rotation\"}}";
   }
   std::string roots;
-  for (std::size_t i = 0; i < tracks.size(); ++i) roots += (i ? "," : "") + std::to_string(i);
+  for (std::size_t i = 0; i < tracks.size(); ++i) {
+    if (i > 0) roots += ',';
+    roots += std::to_string(i);
+  }
   std::string g = "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[" + roots +
                   "]}],\"nodes\":[" + nodes + "]";
   if (!samplers.empty()) {

@@ -25,8 +25,9 @@ constexpr std::int64_t kMaxResolution = 16384;
 
 class SceneParser {
  public:
-  SceneParser(std::string_view text, const std::string& file, const std::string& baseDir)
-      : file_(file), baseDir_(baseDir), root_(detail::parseToml(text, file)) {
+  SceneParser(std::string_view text, const std::string& file, const std::string& baseDir,
+              bool checkFiles)
+      : file_(file), baseDir_(baseDir), checkFiles_(checkFiles), root_(detail::parseToml(text, file)) {
     spec_.file = file;
     spec_.dir = baseDir;
     spec_.sourceText = std::string(text);
@@ -111,7 +112,7 @@ class SceneParser {
       if (p.is_relative()) p = fs::path(baseDir_.empty() ? "." : baseDir_) / p;
       p = p.lexically_normal();
       std::error_code ec;
-      if (!fs::is_regular_file(p, ec)) r.fail("animation", "no such file: " + p.string());
+      if (checkFiles_ && !fs::is_regular_file(p, ec)) r.fail("animation", "no such file: " + p.string());
       spec_.animationFile = p.string();
     }
   }
@@ -416,6 +417,7 @@ class SceneParser {
 
   std::string file_;
   std::string baseDir_;
+  bool checkFiles_ = true;
   toml::table root_;
   SceneSpec spec_;
 };
@@ -472,8 +474,8 @@ SceneSpec loadScene(const std::string& path) {
 }
 
 SceneSpec parseScene(std::string_view text, const std::string& sourceName,
-                     const std::string& baseDir) {
-  return SceneParser(text, sourceName, baseDir).parse();
+                     const std::string& baseDir, bool checkFiles) {
+  return SceneParser(text, sourceName, baseDir, checkFiles).parse();
 }
 
 }  // namespace crumple::io

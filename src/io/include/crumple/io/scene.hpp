@@ -130,8 +130,10 @@ struct SceneSpec {
 // animation file path; does not load the animation.
 SceneSpec loadScene(const std::string& path);
 // Parse scene text; sourceName names it in errors, baseDir resolves paths.
+// checkFiles = false skips the existence check of the animation file (the
+// renderers re-parse a cached scene whose animation need not travel with it).
 SceneSpec parseScene(std::string_view text, const std::string& sourceName,
-                     const std::string& baseDir);
+                     const std::string& baseDir, bool checkFiles = true);
 // SCENE may be a scene.toml or a folder holding one.
 std::string resolveScenePath(const std::string& sceneOrFolder);
 
