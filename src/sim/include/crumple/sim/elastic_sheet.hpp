@@ -69,11 +69,22 @@ class ElasticSheet {
   void setPositions(const std::vector<Vec3>& x);
   void setVelocities(const std::vector<Vec3>& v);
 
-  double kineticEnergy() const;      // J
-  double membraneEnergy() const;     // J
-  double bendingEnergy() const;      // J
+  double kineticEnergy() const;   // J
+  double membraneEnergy() const;  // J
+  double bendingEnergy() const;   // J
   // Max over triangles of the largest absolute principal Green strain.
   double maxMembraneStrain() const;
+
+  // Additions beyond the original interface (diagnostics and tests).
+  double hingeRestAngle(std::size_t hinge) const;
+  double hingeStiffnessFactor(std::size_t hinge) const;
+  // Current signed dihedral angle of a hinge (rad; see sim/energies.hpp for
+  // the sign convention: > 0 when the hinge is convex on the normal side).
+  double hingeAngle(std::size_t hinge) const;
+  // How many times CHOLMOD's symbolic analysis ran (once per pin set).
+  int analyzeCount() const;
+  // Mean pattern edge length (m): the length scale of newtonTolerance.
+  double typicalEdgeLength() const;
 
  private:
   struct Impl;

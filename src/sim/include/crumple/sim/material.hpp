@@ -7,9 +7,9 @@ namespace crumple::sim {
 
 struct Material {
   std::string name;
-  double thickness = 1.0e-4;      // m
-  double density = 700.0;         // kg/m^3
-  double youngsModulus = 4.0e9;   // Pa
+  double thickness = 1.0e-4;     // m
+  double density = 700.0;        // kg/m^3
+  double youngsModulus = 4.0e9;  // Pa
   double poissonRatio = 0.3;
 
   double arealDensity() const { return density * thickness; }  // kg/m^2

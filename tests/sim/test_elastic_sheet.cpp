@@ -1,0 +1,349 @@
+// ElasticSheet integration tests (paper Sec. 4): a hanging A4 sheet comes to
+// rest, determinism across thread counts, hard handle constraints, failure
+// handling and reuse of the symbolic factorisation.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "crumple/core/error.hpp"
+#include "crumple/core/parallel.hpp"
+#include "crumple/mesh/sheet_mesh.hpp"
+#include "crumple/sim/elastic_sheet.hpp"
+
+using namespace crumple;
+using namespace crumple::sim;
+
+namespace {
+
+// The 70 g/m^2 office preset.
+Material officePaper() {
+  Material m;
+  m.name = "office 70 g/m^2";
+  m.thickness = 1e-4;
+  m.density = 700.0;
+  m.youngsModulus = 4e9;
+  m.poissonRatio = 0.3;
+  return m;
+}
+
+constexpr double kWidth = 0.21, kHeight = 0.297;
+
+// An A4 sheet in a vertical plane, tilted by `tilt` rad about its top edge
+// (tilt 0: the plane z = 0, gravity -y in the plane). Pattern v points up.
+mesh::SheetMesh a4Sheet(double tilt, double maxEdge = 0.021) {
+  mesh::SheetMesh m = mesh::makeRectangleSheet(kWidth, kHeight, maxEdge);
+  const Vec3 vAxis(0.0, std::cos(tilt), std::sin(tilt));
+  mesh::placePattern(m, Vec3(0.0, 0.0, 0.0) - kHeight * vAxis, Vec3::UnitX(), vAxis);
+  return m;
+}
+
+// Pins for the two top corners at their initial positions.
+PinFunction topCorners(const mesh::SheetMesh& m) {
+  const int a = mesh::nearestPatternVertex(m, Vec2(0.0, kHeight));
+  const int b = mesh::nearestPatternVertex(m, Vec2(kWidth, kHeight));
+  const Vec3 pa = m.positions[static_cast<std::size_t>(a)];
+  const Vec3 pb = m.positions[static_cast<std::size_t>(b)];
+  return [=](double, std::vector<Pin>& out) {
+    out.push_back({a, pa});
+    out.push_back({b, pb});
+  };
+}
+
+// Steps until the kinetic energy stays below `restEnergy` for 10 steps.
+// Returns the number of steps (or maxSteps).
+int runToRest(ElasticSheet& sheet, const PinFunction& pins, double dt, int maxSteps,
+              double restEnergy) {
+  int quiet = 0;
+  for (int step = 0; step < maxSteps; ++step) {
+    sheet.advance(step * dt, dt, pins);
+    quiet = sheet.kineticEnergy() < restEnergy ? quiet + 1 : 0;
+    if (quiet >= 10) return step + 1;
+  }
+  return maxSteps;
+}
+
+bool bitIdentical(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3)) == 0;
+}
+
+}  // namespace
+
+TEST(ElasticSheet, HangingSheetComesToRest) {
+  const mesh::SheetMesh m = a4Sheet(0.0);
+  ElasticSheet sheet(m, officePaper(), SimParams{});
+  const PinFunction pins = topCorners(m);
+  const double dt = 1.0 / 96.0;
+  const int steps = runToRest(sheet, pins, dt, 2000, 1e-9);
+  RecordProperty("steps", steps);
+  EXPECT_LT(steps, 2000);
+  EXPECT_LT(sheet.kineticEnergy(), 1e-9);
+  EXPECT_LT(sheet.maxMembraneStrain(), 0.01);
+  EXPECT_EQ(sheet.analyzeCount(), 1);
+  // It hangs: the bottom edge went down a little, nothing went up.
+  const int bottom = mesh::nearestPatternVertex(m, Vec2(kWidth / 2, 0.0));
+  EXPECT_LT(sheet.positions()[static_cast<std::size_t>(bottom)].y(),
+            m.positions[static_cast<std::size_t>(bottom)].y());
+  for (const Vec3& p : sheet.positions()) EXPECT_TRUE(p.allFinite());
+}
+
+TEST(ElasticSheet, TiltedHangingSheetSwingsToRest) {
+  // Released 0.3 rad out of the vertical plane: it swings about the line
+  // through the two pins and settles hanging straight down.
+  const mesh::SheetMesh m = a4Sheet(0.3);
+  ElasticSheet sheet(m, officePaper(), SimParams{});
+  const PinFunction pins = topCorners(m);
+  const double dt = 1.0 / 48.0;  // ~400 steps to rest; 1/96 takes ~1000 (both pass)
+  double maxKinetic = 0.0;
+  int steps = 0;
+  int quiet = 0;
+  for (; steps < 1500 && quiet < 10; ++steps) {
+    sheet.advance(steps * dt, dt, pins);
+    maxKinetic = std::max(maxKinetic, sheet.kineticEnergy());
+    quiet = sheet.kineticEnergy() < 1e-9 ? quiet + 1 : 0;
+  }
+  RecordProperty("steps", steps);
+  EXPECT_GT(maxKinetic, 1e-5);  // it really swung
+  EXPECT_LT(sheet.kineticEnergy(), 1e-9);
+  EXPECT_LT(sheet.maxMembraneStrain(), 0.01);
+  // At rest the bottom-middle vertex hangs (almost) straight below the pins.
+  const int bottom = mesh::nearestPatternVertex(m, Vec2(kWidth / 2, 0.0));
+  const Vec3 p = sheet.positions()[static_cast<std::size_t>(bottom)];
+  EXPECT_LT(std::abs(p.z()), 0.01);
+  EXPECT_LT(p.y(), -0.25);
+}
+
+TEST(ElasticSheet, BitIdenticalForAnyThreadCount) {
+  const mesh::SheetMesh m = a4Sheet(0.3);
+  const PinFunction pins = topCorners(m);
+  auto run = [&](int threads) {
+    setThreadCount(threads);
+    ElasticSheet sheet(m, officePaper(), SimParams{});
+    for (int step = 0; step < 30; ++step) sheet.advance(step / 96.0, 1.0 / 96.0, pins);
+    setThreadCount(1);
+    return std::make_pair(sheet.positions(), sheet.velocities());
+  };
+  const auto one = run(1);
+  const auto two = run(2);
+  const auto three = run(3);
+  EXPECT_TRUE(bitIdentical(one.first, two.first));
+  EXPECT_TRUE(bitIdentical(one.second, two.second));
+  EXPECT_TRUE(bitIdentical(one.first, three.first));
+}
+
+TEST(ElasticSheet, PinsFollowAMovingTargetExactly) {
+  const mesh::SheetMesh m = a4Sheet(0.0, 0.03);
+  const int a = mesh::nearestPatternVertex(m, Vec2(0.0, kHeight));
+  const int b = mesh::nearestPatternVertex(m, Vec2(kWidth, kHeight));
+  const Vec3 pa = m.positions[static_cast<std::size_t>(a)];
+  const Vec3 pb = m.positions[static_cast<std::size_t>(b)];
+  auto target = [&](double t) {
+    return Vec3(0.05 * std::sin(3.0 * t), 0.02 * t, 0.04 * (1 - std::cos(2.0 * t)));
+  };
+  const PinFunction pins = [&](double t, std::vector<Pin>& out) {
+    out.push_back({a, pa + target(t)});
+    out.push_back({b, pb + target(t)});
+  };
+  ElasticSheet sheet(m, officePaper(), SimParams{});
+  const double dt = 1.0 / 96.0;
+  for (int step = 0; step < 48; ++step) {
+    const double t = step * dt;
+    sheet.advance(t, dt, pins);
+    const Vec3 ea = pa + target(t + dt), eb = pb + target(t + dt);
+    ASSERT_EQ(sheet.positions()[static_cast<std::size_t>(a)], ea) << "step " << step;
+    ASSERT_EQ(sheet.positions()[static_cast<std::size_t>(b)], eb) << "step " << step;
+  }
+  const Vec3 expectedVelocity = (target(48 * dt) - target(47 * dt)) / dt;
+  EXPECT_LT((sheet.velocities()[static_cast<std::size_t>(a)] - expectedVelocity).norm(), 1e-12);
+  EXPECT_EQ(sheet.analyzeCount(), 1);
+}
+
+TEST(ElasticSheet, HopelessStepThrowsAndRestoresState) {
+  const mesh::SheetMesh m = a4Sheet(0.3, 0.03);
+  const PinFunction good = topCorners(m);
+  ElasticSheet sheet(m, officePaper(), SimParams{});
+  for (int step = 0; step < 5; ++step) sheet.advance(step / 96.0, 1.0 / 96.0, good);
+  const std::vector<Vec3> x = sheet.positions(), v = sheet.velocities();
+
+  const int a = mesh::nearestPatternVertex(m, Vec2(0.0, kHeight));
+  const PinFunction bad = [&](double t, std::vector<Pin>& out) {
+    good(t, out);
+    out.push_back({a, Vec3(std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0)});
+  };
+  try {
+    sheet.advance(5 / 96.0, 1.0 / 96.0, bad);
+    FAIL() << "expected NumericalError";
+  } catch (const NumericalError& e) {
+    EXPECT_EQ(e.stage(), "elastic");
+    EXPECT_NE(std::string(e.what()).find("non-finite pin"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(bitIdentical(sheet.positions(), x));
+  EXPECT_TRUE(bitIdentical(sheet.velocities(), v));
+  // And the sheet carries on afterwards.
+  EXPECT_NO_THROW(sheet.advance(5 / 96.0, 1.0 / 96.0, good));
+}
+
+TEST(ElasticSheet, UnconvergedStepThrowsAfterHalvingAndRestoresState) {
+  // One Newton iteration can never meet the tolerance from a cold predictor:
+  // every level of halving fails and the state is restored.
+  SimParams p;
+  p.maxNewtonIterations = 1;
+  p.maxHalvings = 3;
+  const mesh::SheetMesh m = a4Sheet(0.3, 0.05);
+  ElasticSheet sheet(m, officePaper(), p);
+  EXPECT_THROW(sheet.advance(0.0, 1.0 / 96.0, topCorners(m)), NumericalError);
+  EXPECT_TRUE(bitIdentical(sheet.positions(), m.positions));
+  for (const Vec3& vel : sheet.velocities()) EXPECT_EQ(vel, Vec3::Zero());
+}
+
+TEST(ElasticSheet, LargeStepsAreRescuedByHalving) {
+  // Few Newton iterations allowed, long steps and a fast jerk of the handles:
+  // some steps have to be split, and the result is still a valid state with
+  // the pins in place.
+  SimParams p;
+  p.maxNewtonIterations = 5;
+  const mesh::SheetMesh m = a4Sheet(0.0, 0.03);
+  const int a = mesh::nearestPatternVertex(m, Vec2(0.0, kHeight));
+  const int b = mesh::nearestPatternVertex(m, Vec2(kWidth, kHeight));
+  const Vec3 pa = m.positions[static_cast<std::size_t>(a)];
+  const Vec3 pb = m.positions[static_cast<std::size_t>(b)];
+  auto shift = [](double t) { return Vec3(0.0, 0.0, 0.5 * t); };  // 0.5 m/s out of plane
+  const PinFunction pins = [&](double t, std::vector<Pin>& out) {
+    out.push_back({a, pa + shift(t)});
+    out.push_back({b, pb + shift(t)});
+  };
+  ElasticSheet sheet(m, officePaper(), p);
+  int halvings = 0;
+  const double dt = 1.0 / 24.0;
+  for (int step = 0; step < 8; ++step) halvings += sheet.advance(step * dt, dt, pins).halvings;
+  RecordProperty("halvings", halvings);
+  EXPECT_GT(halvings, 0);
+  EXPECT_EQ(sheet.positions()[static_cast<std::size_t>(a)], pa + shift(7 * dt + dt));
+  for (const Vec3& q : sheet.positions()) EXPECT_TRUE(q.allFinite());
+  EXPECT_LT(sheet.maxMembraneStrain(), 0.01);
+}
+
+TEST(ElasticSheet, CompressionFallsBackToPsdProjectedHessians) {
+  // Pushing the top corners towards each other compresses and buckles the
+  // sheet: the exact Hessian becomes indefinite, CHOLMOD rejects it and the
+  // PSD-projected system is solved instead (an extra factorisation).
+  const mesh::SheetMesh m = a4Sheet(0.0, 0.03);
+  const int a = mesh::nearestPatternVertex(m, Vec2(0.0, kHeight));
+  const int b = mesh::nearestPatternVertex(m, Vec2(kWidth, kHeight));
+  const Vec3 pa = m.positions[static_cast<std::size_t>(a)];
+  const Vec3 pb = m.positions[static_cast<std::size_t>(b)];
+  const PinFunction pins = [&](double t, std::vector<Pin>& out) {
+    const double d = 0.5 * t;
+    out.push_back({a, pa + Vec3(d, 0.0, 0.3 * d)});
+    out.push_back({b, pb - Vec3(d, 0.0, 0.0)});
+  };
+  ElasticSheet sheet(m, officePaper(), SimParams{});
+  int newton = 0, solves = 0;
+  for (int step = 0; step < 12; ++step) {
+    const StepStats s = sheet.advance(step / 96.0, 1.0 / 96.0, pins);
+    newton += s.newtonIterations;
+    solves += s.solves;
+  }
+  EXPECT_GT(solves, newton);
+  EXPECT_LT(sheet.maxMembraneStrain(), 0.01);
+  EXPECT_GT(sheet.bendingEnergy(), 1e-4);  // it buckled out of plane
+  for (const Vec3& q : sheet.positions()) EXPECT_TRUE(q.allFinite());
+}
+
+TEST(ElasticSheet, SymbolicAnalysisIsReusedWhileThePinSetIsUnchanged) {
+  const mesh::SheetMesh m = a4Sheet(0.3, 0.03);
+  ElasticSheet sheet(m, officePaper(), SimParams{});
+  const PinFunction pins = topCorners(m);
+  int solves = 0;
+  for (int step = 0; step < 40; ++step)
+    solves += sheet.advance(step / 96.0, 1.0 / 96.0, pins).solves;
+  EXPECT_EQ(sheet.analyzeCount(), 1);
+  EXPECT_GT(solves, 40);
+  // A different pin set needs a new analysis, once.
+  const int c = mesh::nearestPatternVertex(m, Vec2(kWidth / 2, kHeight));
+  const PinFunction three = [&](double t, std::vector<Pin>& out) {
+    pins(t, out);
+    out.push_back({c, m.positions[static_cast<std::size_t>(c)]});
+  };
+  for (int step = 40; step < 50; ++step) sheet.advance(step / 96.0, 1.0 / 96.0, three);
+  EXPECT_EQ(sheet.analyzeCount(), 2);
+}
+
+TEST(ElasticSheet, FreeFallIsExactWithoutDamping) {
+  // An unstrained sheet falling freely moves rigidly: backward Euler gives
+  // v = g t exactly and the Newton solve converges at once.
+  SimParams p;
+  p.massDamping = 0.0;
+  const mesh::SheetMesh m = a4Sheet(0.7, 0.05);
+  ElasticSheet sheet(m, officePaper(), p);
+  const double dt = 0.01;
+  for (int step = 0; step < 10; ++step) {
+    const StepStats s = sheet.advance(step * dt, dt, PinFunction{});
+    EXPECT_LE(s.newtonIterations, 2);
+  }
+  for (const Vec3& vel : sheet.velocities()) EXPECT_LT((vel - 0.1 * p.gravity).norm(), 1e-9);
+  EXPECT_LT(sheet.maxMembraneStrain(), 1e-12);
+  EXPECT_NEAR(sheet.kineticEnergy(),
+              0.5 * officePaper().arealDensity() * kWidth * kHeight * std::pow(0.1 * 9.81, 2),
+              1e-9);
+}
+
+TEST(ElasticSheet, HingeSettlesAtItsRestAngle) {
+  // Two triangles: pin triangle A, let the wing vertex of B find the rest
+  // angle (no gravity). Checks the sign convention end to end.
+  mesh::SheetMesh m;
+  m.pattern = {Vec2(0, 0), Vec2(0.02, 0), Vec2(0.01, 0.015), Vec2(0.01, -0.015)};
+  m.triangles = {{0, 1, 2}, {1, 0, 3}};
+  m.regionOfTriangle = {0, 0};
+  m.regionTypes = {mesh::RegionType::Flat};
+  mesh::placePattern(m, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
+  SimParams p;
+  p.gravity = Vec3::Zero();
+  p.massDamping = 5.0;
+  ElasticSheet sheet(m, officePaper(), p);
+  ASSERT_EQ(sheet.hinges().size(), 1u);
+  sheet.setHingeRestAngle(0, 0.6);
+  EXPECT_EQ(sheet.hingeRestAngle(0), 0.6);
+  const PinFunction pins = [&](double, std::vector<Pin>& out) {
+    for (int i = 0; i < 3; ++i) out.push_back({i, m.positions[static_cast<std::size_t>(i)]});
+  };
+  for (int step = 0; step < 400; ++step) sheet.advance(step * 0.01, 0.01, pins);
+  EXPECT_NEAR(sheet.hingeAngle(0), 0.6, 1e-6);
+  // theta > 0: the wing went away from the normal side (+z).
+  EXPECT_LT(sheet.positions()[3].z(), 0.0);
+  EXPECT_LT(sheet.bendingEnergy(), 1e-15);
+}
+
+TEST(ElasticSheet, StiffnessDampingDissipates) {
+  SimParams p;
+  p.massDamping = 0.0;
+  p.stiffnessDamping = 1e-3;
+  const mesh::SheetMesh m = a4Sheet(0.3, 0.03);
+  ElasticSheet sheet(m, officePaper(), p);
+  const PinFunction pins = topCorners(m);
+  for (int step = 0; step < 60; ++step) sheet.advance(step / 96.0, 1.0 / 96.0, pins);
+  for (const Vec3& q : sheet.positions()) EXPECT_TRUE(q.allFinite());
+  EXPECT_LT(sheet.maxMembraneStrain(), 0.01);
+}
+
+TEST(ElasticSheet, RejectsBadInput) {
+  mesh::SheetMesh m = a4Sheet(0.0, 0.05);
+  ElasticSheet sheet(m, officePaper(), SimParams{});
+  EXPECT_THROW(sheet.setHingeStiffnessFactor(0, -1.0), std::invalid_argument);
+  EXPECT_THROW(sheet.setHingeRestAngle(sheet.hinges().size(), 0.0), std::out_of_range);
+  EXPECT_THROW(sheet.setPositions({}), std::invalid_argument);
+  std::vector<Vec3> nan = m.positions;
+  nan[3].y() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(sheet.setPositions(nan), std::invalid_argument);
+  EXPECT_THROW(sheet.setVelocities(nan), std::invalid_argument);
+  EXPECT_THROW(sheet.advance(0.0, 0.0, PinFunction{}), std::invalid_argument);
+  const PinFunction outOfRange = [](double, std::vector<Pin>& out) {
+    out.push_back({100000, Vec3::Zero()});
+  };
+  EXPECT_THROW(sheet.advance(0.0, 0.01, outOfRange), std::out_of_range);
+  Material bad = officePaper();
+  bad.poissonRatio = 0.5;
+  EXPECT_THROW(ElasticSheet(m, bad, SimParams{}), std::invalid_argument);
+}
