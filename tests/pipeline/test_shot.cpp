@@ -237,3 +237,40 @@ TEST(Shot, NumericalFailureNamesFrameAndKeepsTheCacheValid) {
     EXPECT_NE(readFile(tmp / "out/summary.json").find("\"error\":\"frame"), std::string::npos);
   }
 }
+
+TEST(Shot, PatternMeshFromTheAnimationFileBecomesTheSheet) {
+  // tests/io/data/anim.gltf holds node "Sheet": a 0.2 x 0.3 m quad lying in
+  // the XZ plane at y = 0.01 m.
+  TempDir tmp;
+  fs::create_directories(tmp / "s");
+  std::string scene = smallSceneToml("", sourcePath("tests/io/data/anim.gltf"));
+  const auto sheetAt = scene.find("[sheet]");
+  const auto paperAt = scene.find("[paper]");
+  const auto first = scene.find("[[handles]]");
+  const auto cameraAt = scene.find("[camera]");
+  scene = scene.substr(0, sheetAt) + "[sheet]\npattern_mesh = \"Sheet\"\n" +
+          scene.substr(paperAt, first - paperAt) + scene.substr(cameraAt);
+  writeFile(tmp / "s/scene.toml", scene);
+  const auto spec = io::loadScene((tmp / "s/scene.toml").string());
+  const auto anim = io::AnimationScene::load(spec.animationFile);
+  const auto sheet = pipeline::buildSheet(spec, &anim);
+  EXPECT_EQ(mesh::validate(sheet), "");
+  ASSERT_EQ(sheet.vertexCount(), 4u);
+  double area = 0.0;
+  for (const auto& t : sheet.triangles) {
+    const Vec2 e1 = sheet.pattern[t[1]] - sheet.pattern[t[0]];
+    const Vec2 e2 = sheet.pattern[t[2]] - sheet.pattern[t[0]];
+    area += 0.5 * (e1.x() * e2.y() - e1.y() * e2.x());
+  }
+  EXPECT_NEAR(area, 0.06, 1e-6) << "counter-clockwise pattern of the right size";
+  for (const auto& p : sheet.positions) EXPECT_NEAR(p.y(), 0.01, 1e-6);
+  // Pattern is isometric to the imported mesh: every edge keeps its length.
+  for (const auto& e : mesh::buildEdges(sheet))
+    EXPECT_NEAR((sheet.pattern[e.v[0]] - sheet.pattern[e.v[1]]).norm(),
+                (sheet.positions[e.v[0]] - sheet.positions[e.v[1]]).norm(), 1e-6);
+  // The shot runs on it (no handles: the sheet falls freely).
+  const auto report = pipeline::runShot(spec, quiet(tmp / "out"));
+  EXPECT_EQ(report.triangles, 2u);
+  const cache::CacheReader reader(report.cachePath);
+  EXPECT_LT(reader.readFrame(reader.frameCount() - 1).positions[0].y(), 0.01);
+}

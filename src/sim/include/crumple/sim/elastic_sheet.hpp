@@ -22,7 +22,7 @@ struct SimParams {
   int maxNewtonIterations = 30;
   // Converged when the max norm of the Newton step is below
   // newtonTolerance * (typical edge length) -- see docs/ARCHITECTURE.md.
-  double newtonTolerance = 1e-8;
+  double newtonTolerance = 1e-7;
   int maxHalvings = 8;  // a failed substep is split in two at most this deep
 };
 
