@@ -14,7 +14,9 @@ namespace {
 std::vector<bool> boundaryVertices(const mesh::SheetMesh& sheet) {
   std::vector<bool> onBoundary(sheet.vertexCount(), false);
   for (const auto& e : mesh::buildEdges(sheet))
-    if (!e.interior()) onBoundary[static_cast<std::size_t>(e.v[0])] = onBoundary[static_cast<std::size_t>(e.v[1])] = true;
+    if (!e.interior())
+      onBoundary[static_cast<std::size_t>(e.v[0])] = onBoundary[static_cast<std::size_t>(e.v[1])] =
+          true;
   return onBoundary;
 }
 
@@ -70,7 +72,8 @@ std::vector<int> tangentNeighbours(const mesh::SheetMesh& sheet, int vertex, int
       if (taken[i]) continue;
       double minAngle = 10.0;
       for (std::size_t j = 0; j < ring.size(); ++j)
-        if (taken[j]) minAngle = std::min(minAngle, std::acos(std::clamp(dirs[i].dot(dirs[j]), -1.0, 1.0)));
+        if (taken[j])
+          minAngle = std::min(minAngle, std::acos(std::clamp(dirs[i].dot(dirs[j]), -1.0, 1.0)));
       if (minAngle > bestScore + 1e-12) {
         bestScore = minAngle;
         best = i;
@@ -89,7 +92,8 @@ HandleRig::HandleRig(const io::SceneSpec& scene, const io::AnimationScene* anima
   std::map<int, std::string> usedVertices;
   for (const auto& spec : scene.handles) {
     if (animation == nullptr)
-      throw InputError(scene.file, "handle '" + spec.name + "' needs an animation file ([scene] animation)");
+      throw InputError(scene.file,
+                       "handle '" + spec.name + "' needs an animation file ([scene] animation)");
     if (!animation->hasNode(spec.node))
       throw InputError(scene.file, "handle '" + spec.name + "': node '" + spec.node +
                                        "' does not exist in " + animation->file());

@@ -25,8 +25,12 @@ FrameMetrics measureFrame(const cache::FrameRecord& frame) {
   double sum = 0.0;
   std::size_t compressed = 0;
   for (const auto& [a, b] : edges) {
-    const double rest = (frame.pattern[static_cast<std::size_t>(a)] - frame.pattern[static_cast<std::size_t>(b)]).norm();
-    const double now = (frame.positions[static_cast<std::size_t>(a)] - frame.positions[static_cast<std::size_t>(b)]).norm();
+    const double rest =
+        (frame.pattern[static_cast<std::size_t>(a)] - frame.pattern[static_cast<std::size_t>(b)])
+            .norm();
+    const double now = (frame.positions[static_cast<std::size_t>(a)] -
+                        frame.positions[static_cast<std::size_t>(b)])
+                           .norm();
     const double strain = (now - rest) / rest;
     sum += std::abs(strain);
     m.maxStrain = std::max(m.maxStrain, std::abs(strain));
@@ -39,7 +43,9 @@ FrameMetrics measureFrame(const cache::FrameRecord& frame) {
   for (std::size_t h = 0; h < frame.handleVertices.size(); ++h) {
     const int v = frame.handleVertices[h];
     if (v < 0) continue;  // released
-    m.handleError = std::max(m.handleError, (frame.positions[static_cast<std::size_t>(v)] - frame.handleTargets[h]).norm());
+    m.handleError =
+        std::max(m.handleError,
+                 (frame.positions[static_cast<std::size_t>(v)] - frame.handleTargets[h]).norm());
   }
   m.singularVertices = frame.singularVertices.size();
   m.junctionVertices = frame.junctionVertices.size();

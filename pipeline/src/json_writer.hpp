@@ -10,10 +10,28 @@ namespace crumple::pipeline {
 
 class JsonWriter {
  public:
-  JsonWriter& beginObject() { separate(); out_ += '{'; first_ = true; return *this; }
-  JsonWriter& endObject() { out_ += '}'; first_ = false; return *this; }
-  JsonWriter& beginArray() { separate(); out_ += '['; first_ = true; return *this; }
-  JsonWriter& endArray() { out_ += ']'; first_ = false; return *this; }
+  JsonWriter& beginObject() {
+    separate();
+    out_ += '{';
+    first_ = true;
+    return *this;
+  }
+  JsonWriter& endObject() {
+    out_ += '}';
+    first_ = false;
+    return *this;
+  }
+  JsonWriter& beginArray() {
+    separate();
+    out_ += '[';
+    first_ = true;
+    return *this;
+  }
+  JsonWriter& endArray() {
+    out_ += ']';
+    first_ = false;
+    return *this;
+  }
   JsonWriter& key(std::string_view k) {
     separate();
     quote(k);
@@ -32,11 +50,27 @@ class JsonWriter {
     }
     return *this;
   }
-  JsonWriter& value(long long v) { separate(); out_ += std::to_string(v); return *this; }
+  JsonWriter& value(long long v) {
+    separate();
+    out_ += std::to_string(v);
+    return *this;
+  }
   JsonWriter& value(int v) { return value(static_cast<long long>(v)); }
-  JsonWriter& value(std::size_t v) { separate(); out_ += std::to_string(v); return *this; }
-  JsonWriter& value(bool v) { separate(); out_ += v ? "true" : "false"; return *this; }
-  JsonWriter& value(std::string_view s) { separate(); quote(s); return *this; }
+  JsonWriter& value(std::size_t v) {
+    separate();
+    out_ += std::to_string(v);
+    return *this;
+  }
+  JsonWriter& value(bool v) {
+    separate();
+    out_ += v ? "true" : "false";
+    return *this;
+  }
+  JsonWriter& value(std::string_view s) {
+    separate();
+    quote(s);
+    return *this;
+  }
   JsonWriter& value(const char* s) { return value(std::string_view(s)); }
   const std::string& str() const { return out_; }
 
@@ -49,11 +83,21 @@ class JsonWriter {
     out_ += '"';
     for (char c : s) {
       switch (c) {
-        case '"': out_ += "\\\""; break;
-        case '\\': out_ += "\\\\"; break;
-        case '\n': out_ += "\\n"; break;
-        case '\t': out_ += "\\t"; break;
-        case '\r': out_ += "\\r"; break;
+        case '"':
+          out_ += "\\\"";
+          break;
+        case '\\':
+          out_ += "\\\\";
+          break;
+        case '\n':
+          out_ += "\\n";
+          break;
+        case '\t':
+          out_ += "\\t";
+          break;
+        case '\r':
+          out_ += "\\r";
+          break;
         default:
           if (static_cast<unsigned char>(c) < 0x20) {
             char buf[8];

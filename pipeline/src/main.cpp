@@ -47,8 +47,8 @@ int runOrSimulate(const Args& a, bool render) {
 int renderCommand(const Args& a) {
   setThreadCount(a.threads);
   if (a.backend != "osmesa")
-    throw InputError("--backend", "'" + a.backend +
-                                      "' is not available yet; this build renders with osmesa");
+    throw InputError("--backend",
+                     "'" + a.backend + "' is not available yet; this build renders with osmesa");
   pipeline::RenderOptions options;
   if (!a.frames.empty()) options.frames = pipeline::parseFrameRange(a.frames);
   options.framesDir = a.out;
@@ -75,25 +75,32 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   Args a;
 
-  auto* run = app.add_subcommand("run", "Simulate a shot, write its cache and render its frames (OSMesa).");
+  auto* run =
+      app.add_subcommand("run", "Simulate a shot, write its cache and render its frames (OSMesa).");
   auto* simulate = app.add_subcommand("simulate", "Simulate a shot and write its cache only.");
   for (auto* cmd : {run, simulate}) {
     cmd->add_option("SCENE", a.scene, "scene.toml, or a folder holding one")->required();
-    cmd->add_option("--out", a.out, "output folder (default: the scene's [output] dir, else out/<scene name>)");
-    cmd->add_option("--frames", a.frames,
-                    "A-B: simulate from the scene's first frame to B, render A-B (default: the scene's range)");
+    cmd->add_option("--out", a.out,
+                    "output folder (default: the scene's [output] dir, else out/<scene name>)");
+    cmd->add_option(
+        "--frames", a.frames,
+        "A-B: simulate from the scene's first frame to B, render A-B (default: the scene's range)");
     cmd->add_option("--seed", a.seed, "override the scene's seed");
     cmd->add_option("--threads", a.threads, "worker threads; results are identical for any count")
         ->check(CLI::Range(1, 256));
   }
-  auto* render = app.add_subcommand("render", "Render frames of a cache (frame-parallel farm work).");
+  auto* render =
+      app.add_subcommand("render", "Render frames of a cache (frame-parallel farm work).");
   render->add_option("CACHE", a.cache, "a .pcache file")->required();
   render->add_option("--frames", a.frames, "A-B: frames to render (default: every cached frame)");
-  render->add_option("--backend", a.backend, "renderer: osmesa (embree comes with the rendering issue)")
+  render
+      ->add_option("--backend", a.backend,
+                   "renderer: osmesa (embree comes with the rendering issue)")
       ->capture_default_str();
   render->add_option("--out", a.out, "frames folder (default: frames/ beside the cache)");
   render->add_option("--threads", a.threads, "worker threads")->check(CLI::Range(1, 256));
-  auto* inspect = app.add_subcommand("inspect", "Print per-frame sizes, strain and handle error of a cache.");
+  auto* inspect =
+      app.add_subcommand("inspect", "Print per-frame sizes, strain and handle error of a cache.");
   inspect->add_option("CACHE", a.cache, "a .pcache file")->required();
   inspect->add_flag("--json", a.json, "one JSON object for scripts");
 

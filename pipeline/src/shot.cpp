@@ -1,6 +1,8 @@
 #include "crumple/pipeline/shot.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -8,9 +10,7 @@
 #include <fstream>
 #include <limits>
 #include <memory>
-#include <regex>
-
-#include <Eigen/Eigenvalues>
+#include <string_view>
 
 #include "crumple/core/error.hpp"
 #include "crumple/core/progress.hpp"
@@ -76,9 +76,8 @@ cache::CameraRecord cameraAt(const io::SceneSpec& scene, const io::AnimationScen
     rec.yfov = cam->yfov > 0.0 && !scene.camera.fovExplicit ? cam->yfov : scene.camera.yfov;
     return rec;
   }
-  const auto c = render::Camera::lookAt(scene.camera.position, scene.camera.lookAt,
-                                        scene.camera.up, scene.camera.yfov, scene.camera.width,
-                                        scene.camera.height);
+  const auto c = render::Camera::lookAt(scene.camera.position, scene.camera.lookAt, scene.camera.up,
+                                        scene.camera.yfov, scene.camera.width, scene.camera.height);
   rec.position = c.position;
   rec.rotation = c.rotation;
   rec.yfov = c.yfov;
@@ -127,10 +126,10 @@ class FrameRenderer {
 
 void validateRange(const io::SceneSpec& scene, const FrameRange& range) {
   if (range.first < scene.frameStart || range.last > scene.frameEnd)
-    throw InputError(scene.file, "--frames " + std::to_string(range.first) + "-" +
-                                     std::to_string(range.last) + " is outside the scene's frames " +
-                                     std::to_string(scene.frameStart) + "-" +
-                                     std::to_string(scene.frameEnd));
+    throw InputError(
+        scene.file, "--frames " + std::to_string(range.first) + "-" + std::to_string(range.last) +
+                        " is outside the scene's frames " + std::to_string(scene.frameStart) + "-" +
+                        std::to_string(scene.frameEnd));
 }
 
 void writeTextAtomically(const std::string& path, const std::string& text) {
@@ -147,13 +146,19 @@ void writeTextAtomically(const std::string& path, const std::string& text) {
 }  // namespace
 
 FrameRange parseFrameRange(const std::string& text) {
-  static const std::regex pattern(R"(^\s*(-?\d+)\s*(?:-\s*(-?\d+))?\s*$)");
-  std::smatch m;
-  if (!std::regex_match(text, m, pattern))
-    throw InputError("--frames", "expected A-B or A, got '" + text + "'");
+  // "A-B" or "A", A and B integers (A may be negative: "-5--2" is -5 to -2).
+  const auto bad = [&] { return InputError("--frames", "expected A-B or A, got '" + text + "'"); };
+  const auto parseInt = [&](std::string_view s) {
+    int value = 0;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
+    if (s.empty() || ec != std::errc() || end != s.data() + s.size()) throw bad();
+    return value;
+  };
+  const std::string_view all(text);
+  const auto dash = all.find('-', 1);  // a leading '-' is a sign
   FrameRange r;
-  r.first = std::stoi(m[1].str());
-  r.last = m[2].matched ? std::stoi(m[2].str()) : r.first;
+  r.first = parseInt(all.substr(0, dash));
+  r.last = dash == std::string_view::npos ? r.first : parseInt(all.substr(dash + 1));
   if (r.last < r.first) throw InputError("--frames", "range " + text + " ends before it starts");
   return r;
 }
@@ -199,8 +204,10 @@ mesh::SheetMesh buildSheet(const io::SceneSpec& scene, const io::AnimationScene*
   for (auto& p : sheet.pattern) p -= lo;
   for (auto t : imported->triangles) {
     // Orient every triangle counter-clockwise in the pattern.
-    const Vec2 e1 = sheet.pattern[static_cast<std::size_t>(t[1])] - sheet.pattern[static_cast<std::size_t>(t[0])];
-    const Vec2 e2 = sheet.pattern[static_cast<std::size_t>(t[2])] - sheet.pattern[static_cast<std::size_t>(t[0])];
+    const Vec2 e1 = sheet.pattern[static_cast<std::size_t>(t[1])] -
+                    sheet.pattern[static_cast<std::size_t>(t[0])];
+    const Vec2 e2 = sheet.pattern[static_cast<std::size_t>(t[2])] -
+                    sheet.pattern[static_cast<std::size_t>(t[0])];
     if (e1.x() * e2.y() - e1.y() * e2.x() < 0.0) std::swap(t[1], t[2]);
     sheet.triangles.push_back(t);
   }
@@ -240,7 +247,7 @@ render::RenderScene makeRenderScene(const io::SceneSpec& scene, const cache::Cam
 
 ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   ShotReport report;
-  report.outDir = !options.outDir.empty()    ? options.outDir
+  report.outDir = !options.outDir.empty()     ? options.outDir
                   : !scene.output.dir.empty() ? scene.output.dir
                                               : (fs::path("out") / scene.name).string();
   FrameRange range{scene.frameStart, scene.frameEnd};
@@ -261,11 +268,13 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   const double t0 = frameTime(scene, scene.frameStart);
   const HandleRig rig(scene, animation.get(), sheet, t0);
   rig.snap(t0, sheet.positions);
-  for (int f = scene.frameStart; f <= range.last; ++f) (void)cameraAt(scene, animation.get(), frameTime(scene, f));
+  for (int f = scene.frameStart; f <= range.last; ++f)
+    (void)cameraAt(scene, animation.get(), frameTime(scene, f));
   prepareOutputDir(report.outDir, "output");
   report.cachePath = (fs::path(report.outDir) / "cache.pcache").string();
   if (animation)
-    for (const auto& w : animation->warnings()) report.warnings.push_back(animation->file() + ": " + w);
+    for (const auto& w : animation->warnings())
+      report.warnings.push_back(animation->file() + ": " + w);
   report.summaryPath = (fs::path(report.outDir) / "summary.json").string();
   std::unique_ptr<FrameRenderer> renderer;
   if (render) {
@@ -291,7 +300,8 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   header.sceneFile = scene.file;
   header.sceneText = scene.sourceText;
   header.sheetWidth = scene.sheet.kind == io::SheetSpec::Kind::Rectangle ? scene.sheet.width : 0.0;
-  header.sheetHeight = scene.sheet.kind == io::SheetSpec::Kind::Rectangle ? scene.sheet.height : 0.0;
+  header.sheetHeight =
+      scene.sheet.kind == io::SheetSpec::Kind::Rectangle ? scene.sheet.height : 0.0;
   header.paperName = scene.paper.name;
   header.paperThickness = scene.paper.thickness;
   for (const auto& h : rig.handles()) header.handleNames.push_back(h.name);
@@ -384,9 +394,10 @@ RenderReport renderCache(const std::string& cachePath, const RenderOptions& opti
   const cache::CacheReader reader(cachePath);
   if (reader.frameCount() == 0) throw InputError(cachePath, "the cache holds no frames");
   const auto& header = reader.header();
-  const io::SceneSpec scene = io::parseScene(header.sceneText, header.sceneFile + " (in " + cachePath + ")",
-                                             fs::path(header.sceneFile).parent_path().string(),
-                                             /*checkFiles=*/false);
+  const io::SceneSpec scene =
+      io::parseScene(header.sceneText, header.sceneFile + " (in " + cachePath + ")",
+                     fs::path(header.sceneFile).parent_path().string(),
+                     /*checkFiles=*/false);
   RenderReport report;
   report.framesDir = !options.framesDir.empty()
                          ? options.framesDir
@@ -397,13 +408,15 @@ RenderReport renderCache(const std::string& cachePath, const RenderOptions& opti
   if (options.frames) {
     range = *options.frames;
     if (range.first < firstCached || range.last > lastCached)
-      throw InputError(cachePath, "--frames " + std::to_string(range.first) + "-" +
-                                      std::to_string(range.last) + " is outside the cached frames " +
-                                      std::to_string(firstCached) + "-" + std::to_string(lastCached));
+      throw InputError(
+          cachePath, "--frames " + std::to_string(range.first) + "-" + std::to_string(range.last) +
+                         " is outside the cached frames " + std::to_string(firstCached) + "-" +
+                         std::to_string(lastCached));
   }
   prepareOutputDir(report.framesDir, "frames");
   FrameRenderer renderer(scene, report.framesDir);
-  Progress progress("crumple render", range.last - range.first + 1, options.log, options.interactive);
+  Progress progress("crumple render", range.last - range.first + 1, options.log,
+                    options.interactive);
   for (int f = range.first; f <= range.last; ++f) {
     const auto frame = reader.readFrame(static_cast<std::size_t>(f - firstCached));
     const auto start = Clock::now();
@@ -420,7 +433,8 @@ RenderReport renderCache(const std::string& cachePath, const RenderOptions& opti
 std::string summaryText(const ShotReport& r) {
   std::string out;
   char line[512];
-  std::snprintf(line, sizeof line, "%d frames simulated (%zu vertices, %zu triangles), %d rendered\n",
+  std::snprintf(line, sizeof line,
+                "%d frames simulated (%zu vertices, %zu triangles), %d rendered\n",
                 r.framesSimulated, r.vertices, r.triangles, r.framesRendered);
   out += line;
   for (const auto& [name, cost] : r.stages) {

@@ -58,9 +58,12 @@ TEST(ParallelFor, CoversEveryIndexOnceForAnyThreadCount) {
   for (int threads : {1, 2, 3, 8}) {
     setThreadCount(threads);
     std::vector<int> hits(10007, 0);
-    parallelFor(hits.size(), [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) ++hits[i];
-    }, 16);
+    parallelFor(
+        hits.size(),
+        [&](std::size_t b, std::size_t e) {
+          for (std::size_t i = b; i < e; ++i) ++hits[i];
+        },
+        16);
     for (int h : hits) ASSERT_EQ(h, 1) << "threads " << threads;
   }
   setThreadCount(1);
@@ -68,8 +71,12 @@ TEST(ParallelFor, CoversEveryIndexOnceForAnyThreadCount) {
 
 TEST(ParallelFor, RethrowsAWorkerException) {
   setThreadCount(2);
-  EXPECT_THROW(parallelFor(1000, [](std::size_t b, std::size_t) {
-    if (b > 0) throw std::runtime_error("boom");
-  }, 10), std::runtime_error);
+  EXPECT_THROW(parallelFor(
+                   1000,
+                   [](std::size_t b, std::size_t) {
+                     if (b > 0) throw std::runtime_error("boom");
+                   },
+                   10),
+               std::runtime_error);
   setThreadCount(1);
 }

@@ -36,7 +36,10 @@ TEST(Cli, RunWritesCacheFramesSummaryAndProgressLines) {
   }
   // Not a terminal: one PROGRESS line per frame, ending at 100.
   std::size_t lines = 0, pos = 0;
-  while ((pos = r.output.find("PROGRESS ", pos)) != std::string::npos) { ++lines; ++pos; }
+  while ((pos = r.output.find("PROGRESS ", pos)) != std::string::npos) {
+    ++lines;
+    ++pos;
+  }
   EXPECT_EQ(lines, 6u);
   EXPECT_NE(r.output.find("PROGRESS 100"), std::string::npos);
   // The closing summary says where things went and what each stage cost.
@@ -50,15 +53,18 @@ TEST(Cli, RunWritesCacheFramesSummaryAndProgressLines) {
 TEST(Cli, InspectJsonHasTheDocumentedKeys) {
   TempDir tmp;
   writeSmallScene(tmp / "scene");
-  ASSERT_EQ(runCrumple("simulate " + (tmp / "scene").string() + " --out " + (tmp / "out").string()).status, 0);
+  ASSERT_EQ(runCrumple("simulate " + (tmp / "scene").string() + " --out " + (tmp / "out").string())
+                .status,
+            0);
   EXPECT_FALSE(fs::exists(tmp / "out/frames")) << "simulate renders nothing";
-  const auto r = runCommand(std::string(CRUMPLE_BIN) + " inspect --json " + (tmp / "out/cache.pcache").string() + " 2>/dev/null");
+  const auto r = runCommand(std::string(CRUMPLE_BIN) + " inspect --json " +
+                            (tmp / "out/cache.pcache").string() + " 2>/dev/null");
   ASSERT_EQ(r.status, 0);
-  for (const char* key : {"\"format_version\"", "\"fps\"", "\"frame_count\":6", "\"frames\"",
-                          "\"frame\"", "\"time\"", "\"vertices\"", "\"triangles\"", "\"c_mean\"",
-                          "\"n_comp\"", "\"max_strain\"", "\"handle_error\"", "\"handles\"",
-                          "\"name\":\"left\"", "\"position\"", "\"singular_vertices\":0",
-                          "\"junction_vertices\":0", "\"tears\":0"})
+  for (const char* key :
+       {"\"format_version\"", "\"fps\"", "\"frame_count\":6", "\"frames\"", "\"frame\"", "\"time\"",
+        "\"vertices\"", "\"triangles\"", "\"c_mean\"", "\"n_comp\"", "\"max_strain\"",
+        "\"handle_error\"", "\"handles\"", "\"name\":\"left\"", "\"position\"",
+        "\"singular_vertices\":0", "\"junction_vertices\":0", "\"tears\":0"})
     EXPECT_NE(r.output.find(key), std::string::npos) << key;
   EXPECT_EQ(r.output.front(), '{');
   const auto text = runCrumple("inspect " + (tmp / "out/cache.pcache").string());
@@ -69,26 +75,38 @@ TEST(Cli, InspectJsonHasTheDocumentedKeys) {
 TEST(Cli, RenderAFrameRangeFromTheCacheAlone) {
   TempDir tmp;
   writeSmallScene(tmp / "scene");
-  ASSERT_EQ(runCrumple("run " + (tmp / "scene").string() + " --out " + (tmp / "a").string()).status, 0);
+  ASSERT_EQ(runCrumple("run " + (tmp / "scene").string() + " --out " + (tmp / "a").string()).status,
+            0);
   // The render command needs only the cache: move the scene away.
   fs::remove_all(tmp / "scene");
-  const auto r = runCrumple("render " + (tmp / "a/cache.pcache").string() + " --frames 3-4 --backend osmesa --out " +
-                         (tmp / "b").string());
+  const auto r = runCrumple("render " + (tmp / "a/cache.pcache").string() +
+                            " --frames 3-4 --backend osmesa --out " + (tmp / "b").string());
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_FALSE(fs::exists(tmp / "b/0002.png"));
   EXPECT_TRUE(fs::exists(tmp / "b/0005.png") == false);
   for (const char* f : {"0003.png", "0004.png"})
-    EXPECT_EQ(readFile(tmp / "b" / f), readFile(tmp / "a/frames" / f)) << f << " re-rendered identically";
+    EXPECT_EQ(readFile(tmp / "b" / f), readFile(tmp / "a/frames" / f))
+        << f << " re-rendered identically";
   EXPECT_EQ(runCrumple("render " + (tmp / "a/cache.pcache").string() + " --frames 5-9").status, 2);
-  EXPECT_EQ(runCrumple("render " + (tmp / "a/cache.pcache").string() + " --backend vulkan").status, 2);
+  EXPECT_EQ(runCrumple("render " + (tmp / "a/cache.pcache").string() + " --backend vulkan").status,
+            2);
 }
 
 TEST(Cli, SameSeedGivesIdenticalBytesOnOneAndTwoThreads) {
   TempDir tmp;
   writeSmallScene(tmp / "scene");
-  ASSERT_EQ(runCrumple("run " + (tmp / "scene").string() + " --threads 1 --out " + (tmp / "t1").string()).status, 0);
-  ASSERT_EQ(runCrumple("run " + (tmp / "scene").string() + " --threads 2 --out " + (tmp / "t2").string()).status, 0);
-  ASSERT_EQ(runCrumple("run " + (tmp / "scene").string() + " --threads 1 --out " + (tmp / "t3").string()).status, 0);
+  ASSERT_EQ(
+      runCrumple("run " + (tmp / "scene").string() + " --threads 1 --out " + (tmp / "t1").string())
+          .status,
+      0);
+  ASSERT_EQ(
+      runCrumple("run " + (tmp / "scene").string() + " --threads 2 --out " + (tmp / "t2").string())
+          .status,
+      0);
+  ASSERT_EQ(
+      runCrumple("run " + (tmp / "scene").string() + " --threads 1 --out " + (tmp / "t3").string())
+          .status,
+      0);
   const auto c1 = readFile(tmp / "t1/cache.pcache");
   ASSERT_FALSE(c1.empty());
   EXPECT_EQ(c1, readFile(tmp / "t2/cache.pcache"));
@@ -110,7 +128,8 @@ class BadInput : public ::testing::Test {
   void expectRejected(const std::string& args, const std::vector<std::string>& mentions) {
     const auto r = runCrumple(args + " --out " + (tmp_ / "out").string());
     EXPECT_EQ(r.status, 2) << r.output;
-    for (const auto& m : mentions) EXPECT_NE(r.output.find(m), std::string::npos) << "missing '" << m << "' in: " << r.output;
+    for (const auto& m : mentions)
+      EXPECT_NE(r.output.find(m), std::string::npos) << "missing '" << m << "' in: " << r.output;
     EXPECT_FALSE(fs::exists(tmp_ / "out/cache.pcache"));
     EXPECT_FALSE(fs::exists(tmp_ / "out/frames/0001.png"));
   }
@@ -160,7 +179,8 @@ TEST_F(BadInput, UnwritableOutputFolder) {
   writeSmallScene(tmp_ / "s");
   // A path below a regular file can never be created, even by root.
   writeFile(tmp_ / "blocker", "x");
-  const auto r = runCrumple("run " + (tmp_ / "s").string() + " --out " + (tmp_ / "blocker/out").string());
+  const auto r =
+      runCrumple("run " + (tmp_ / "s").string() + " --out " + (tmp_ / "blocker/out").string());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("blocker/out"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(tmp_ / "blocker/out"));

@@ -53,7 +53,8 @@ TEST(Shot, DrapeSampleFollowsItsHandlesAndStaysFinite) {
   auto options = quiet(tmp / "out", true);
   options.frames = pipeline::FrameRange{1, 24};
   const auto report = pipeline::runShot(scene, options);
-  EXPECT_EQ(report.framesSimulated, 25) << "frames 0-24: simulation starts at the scene's first frame";
+  EXPECT_EQ(report.framesSimulated, 25)
+      << "frames 0-24: simulation starts at the scene's first frame";
   EXPECT_EQ(report.framesRendered, 24);
   EXPECT_TRUE(fs::exists(tmp / "out/frames/0024.png"));
   const auto anim = io::AnimationScene::load(scene.animationFile);
@@ -71,8 +72,8 @@ TEST(Shot, HandlesTrackTheirCurvesForEveryFormat) {
   // One animation written as glTF, FBX and COLLADA (tests/io/data): the
   // cached handle vertex follows the imported track to 1e-6 m at every frame,
   // and the three formats give the same trajectories to 1e-5 m.
-  const std::vector<std::string> files = {"tests/io/data/anim.gltf", "tests/io/data/anim_zup_cm.fbx",
-                                          "tests/io/data/anim_zup_cm.dae"};
+  const std::vector<std::string> files = {
+      "tests/io/data/anim.gltf", "tests/io/data/anim_zup_cm.fbx", "tests/io/data/anim_zup_cm.dae"};
   std::vector<std::vector<Vec3>> trajectories;
   for (const auto& file : files) {
     TempDir tmp;
@@ -109,7 +110,8 @@ TEST(Shot, HandlesTrackTheirCurvesForEveryFormat) {
   for (std::size_t f = 1; f < trajectories.size(); ++f) {
     ASSERT_EQ(trajectories[f].size(), trajectories[0].size());
     for (std::size_t i = 0; i < trajectories[0].size(); ++i)
-      EXPECT_LT((trajectories[f][i] - trajectories[0][i]).norm(), 1e-5) << files[f] << " sample " << i;
+      EXPECT_LT((trajectories[f][i] - trajectories[0][i]).norm(), 1e-5)
+          << files[f] << " sample " << i;
   }
 }
 
@@ -177,14 +179,17 @@ TEST(HandleRig, TangentVerticesFollowTheNodeRotation) {
   fs::create_directories(tmp / "s");
   // A node that rotates 90 degrees about Y over one second, in place.
   const float h = static_cast<float>(std::sqrt(0.5));
-  GltfTrack a{"A", {0.0f, 1.0f}, {{-0.05f, 0.2f, 0.0f}, {-0.05f, 0.2f, 0.0f}},
+  GltfTrack a{"A",
+              {0.0f, 1.0f},
+              {{-0.05f, 0.2f, 0.0f}, {-0.05f, 0.2f, 0.0f}},
               {{0.0f, 0.0f, 0.0f, 1.0f}, {0.0f, h, 0.0f, h}}};
   writeFile(tmp / "s/anim.gltf", makeGltf({a}));
   std::string scene = smallSceneToml();
   const auto first = scene.find("[[handles]]");
   const auto cameraAt = scene.find("[camera]");
   scene = scene.substr(0, first) +
-          "[[handles]]\nname = \"left\"\nnode = \"A\"\npattern = [0.0, 10.0]\ntangent_control = true\n" +
+          "[[handles]]\nname = \"left\"\nnode = \"A\"\npattern = [0.0, 10.0]\ntangent_control = "
+          "true\n" +
           scene.substr(cameraAt);
   writeFile(tmp / "s/scene.toml", scene);
   const auto spec = io::loadScene((tmp / "s/scene.toml").string());
@@ -214,7 +219,9 @@ TEST(Shot, NumericalFailureNamesFrameAndKeepsTheCacheValid) {
   // stage, and the cache must hold every frame before it.
   TempDir tmp;
   fs::create_directories(tmp / "s");
-  GltfTrack a{"A", {0.0f, 0.1f, 0.125f}, {{-0.05f, 0.2f, 0.0f}, {-0.05f, 0.2f, 0.0f}, {-0.05f, 1e4f, 0.0f}}};
+  GltfTrack a{"A",
+              {0.0f, 0.1f, 0.125f},
+              {{-0.05f, 0.2f, 0.0f}, {-0.05f, 0.2f, 0.0f}, {-0.05f, 1e4f, 0.0f}}};
   GltfTrack b{"B", {}, {{0.05f, 0.2f, 0.0f}}};
   writeFile(tmp / "s/anim.gltf", makeGltf({a, b}));
   writeFile(tmp / "s/scene.toml", smallSceneToml());
@@ -273,4 +280,15 @@ TEST(Shot, PatternMeshFromTheAnimationFileBecomesTheSheet) {
   EXPECT_EQ(report.triangles, 2u);
   const cache::CacheReader reader(report.cachePath);
   EXPECT_LT(reader.readFrame(reader.frameCount() - 1).positions[0].y(), 0.01);
+}
+
+TEST(FrameRange, ParsesRangesAndRejectsTheRest) {
+  const auto r = pipeline::parseFrameRange("3-17");
+  EXPECT_EQ(r.first, 3);
+  EXPECT_EQ(r.last, 17);
+  EXPECT_EQ(pipeline::parseFrameRange("5").last, 5);
+  EXPECT_EQ(pipeline::parseFrameRange("-4--2").first, -4);
+  EXPECT_EQ(pipeline::parseFrameRange("-4--2").last, -2);
+  for (const char* bad : {"", "a-b", "3-", "-", "3-1", "1-2-3", "1.5-2", " 1-2"})
+    EXPECT_THROW(pipeline::parseFrameRange(bad), InputError) << bad;
 }

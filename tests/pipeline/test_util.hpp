@@ -1,6 +1,7 @@
 #pragma once
 // Helpers for scene-level tests: temporary folders, running the CLI, files.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <array>
 #include <cstdio>
@@ -8,7 +9,6 @@
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 
 namespace crumple::testing {
 
@@ -19,9 +19,8 @@ class TempDir {
  public:
   TempDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() /
-            (std::string("crumple-") + info->test_suite_name() + "-" + info->name() + "-" +
-             std::to_string(::getpid()));
+    path_ = fs::temp_directory_path() / (std::string("crumple-") + info->test_suite_name() + "-" +
+                                         info->name() + "-" + std::to_string(::getpid()));
     fs::remove_all(path_);
     fs::create_directories(path_);
   }
@@ -47,7 +46,8 @@ inline CommandResult runCommand(const std::string& command) {
   std::FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
   if (pipe == nullptr) return r;
   std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), static_cast<int>(buf.size()), pipe) != nullptr) r.output += buf.data();
+  while (std::fgets(buf.data(), static_cast<int>(buf.size()), pipe) != nullptr)
+    r.output += buf.data();
   const int raw = ::pclose(pipe);
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
   return r;
@@ -120,7 +120,8 @@ inline std::string makeGltf(const std::vector<GltfTrack>& tracks) {
     accessors += "{\"bufferView\":" + std::to_string(accessor) +
                  ",\"componentType\":5126,\"count\":" + std::to_string(count) + ",\"type\":\"" +
                  type + "\"";
-    if (minmax) accessors += ",\"min\":[" + std::to_string(lo) + "],\"max\":[" + std::to_string(hi) + "]";
+    if (minmax)
+      accessors += ",\"min\":[" + std::to_string(lo) + "],\"max\":[" + std::to_string(hi) + "]";
     accessors += "}";
     return accessor++;
   };
@@ -140,15 +141,15 @@ inline std::string makeGltf(const std::vector<GltfTrack>& tracks) {
     samplers += "{\"input\":" + std::to_string(in) + ",\"output\":" + std::to_string(out) +
                 ",\"interpolation\":\"LINEAR\"}";
     if (!channels.empty()) channels += ",";
-    channels += "{\"sampler\":" + std::to_string(sampler++) + ",\"target\":{\"node\":" +
-                std::to_string(i) + ",\"path\":\"translation\"}}";
+    channels += "{\"sampler\":" + std::to_string(sampler++) +
+                ",\"target\":{\"node\":" + std::to_string(i) + ",\"path\":\"translation\"}}";
     if (t.rotations.size() != t.times.size()) continue;
     const int rot = append(t.rotations.data(), t.rotations.size() * 16,
                            static_cast<int>(t.rotations.size()), "VEC4", false, 0, 0);
     samplers += ",{\"input\":" + std::to_string(in) + ",\"output\":" + std::to_string(rot) +
                 ",\"interpolation\":\"LINEAR\"}";
-    channels += ",{\"sampler\":" + std::to_string(sampler++) + ",\"target\":{\"node\":" +
-                std::to_string(i) + ",\"path\":\"rotation\"}}";
+    channels += ",{\"sampler\":" + std::to_string(sampler++) +
+                ",\"target\":{\"node\":" + std::to_string(i) + ",\"path\":\"rotation\"}}";
   }
   std::string roots;
   for (std::size_t i = 0; i < tracks.size(); ++i) {
@@ -175,9 +176,12 @@ namespace crumple::testing {
 inline std::string smallSceneToml(const std::string& extraSheet = "",
                                   const std::string& animation = "anim.gltf") {
   return "[scene]\nname = \"small\"\nunits = \"cm\"\nfps = 24\nframes = [1, 6]\nsubsteps = 2\n"
-         "seed = 7\nanimation = \"" + animation + "\"\n"
+         "seed = 7\nanimation = \"" +
+         animation +
+         "\"\n"
          "[sheet]\nwidth = 10.0\nheight = 10.0\nmax_edge = 2.5\norigin = [-5.0, 10.0, 0.0]\n"
-         "u_axis = [1.0, 0.0, 0.0]\nv_axis = [0.0, 1.0, 0.0]\n" + extraSheet +
+         "u_axis = [1.0, 0.0, 0.0]\nv_axis = [0.0, 1.0, 0.0]\n" +
+         extraSheet +
          "[paper]\npreset = \"office-70gsm\"\n"
          "[[handles]]\nname = \"left\"\nnode = \"A\"\npattern = [0.0, 10.0]\n"
          "[[handles]]\nname = \"right\"\nnode = \"B\"\npattern = [10.0, 10.0]\n"
@@ -187,8 +191,12 @@ inline std::string smallSceneToml(const std::string& extraSheet = "",
 }
 
 inline std::string smallAnimation(float nanAt = 0.0f) {
-  GltfTrack a{"A", {0.0f, 0.1f, 0.25f}, {{-0.05f, 0.20f, 0.0f}, {-0.06f, 0.20f, 0.01f}, {-0.04f, 0.21f, 0.0f}}};
-  GltfTrack b{"B", {0.0f, 0.1f, 0.25f}, {{0.05f, 0.20f, 0.0f}, {0.06f, 0.20f, 0.01f}, {0.04f, 0.21f, 0.0f}}};
+  GltfTrack a{"A",
+              {0.0f, 0.1f, 0.25f},
+              {{-0.05f, 0.20f, 0.0f}, {-0.06f, 0.20f, 0.01f}, {-0.04f, 0.21f, 0.0f}}};
+  GltfTrack b{"B",
+              {0.0f, 0.1f, 0.25f},
+              {{0.05f, 0.20f, 0.0f}, {0.06f, 0.20f, 0.01f}, {0.04f, 0.21f, 0.0f}}};
   if (nanAt != 0.0f) a.positions[1][1] = nanAt;
   return makeGltf({a, b});
 }

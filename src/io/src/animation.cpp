@@ -142,35 +142,41 @@ double ticksToSeconds(double ticks, double ticksPerSecond) {
   return ticks / (ticksPerSecond > 0.0 ? ticksPerSecond : kFallbackTicksPerSecond);
 }
 
+namespace {
+// The two keys around t and the blend between them, clamped at both ends
+// (lo == hi, s == 0 outside the keyed span); n must be > 0.
+struct KeyBracket {
+  std::size_t lo = 0, hi = 0;
+  double s = 0.0;
+};
+KeyBracket bracket(const std::vector<double>& times, std::size_t n, double t) {
+  if (n == 1 || !(t > times.front())) return {0, 0, 0.0};
+  if (t >= times[n - 1]) return {n - 1, n - 1, 0.0};
+  const auto hi = static_cast<std::size_t>(
+      std::upper_bound(times.begin(), times.begin() + static_cast<std::ptrdiff_t>(n), t) -
+      times.begin());
+  const std::size_t lo = hi - 1;
+  const double dt = times[hi] - times[lo];
+  if (!(dt > 0.0)) return {hi, hi, 0.0};
+  return {lo, hi, (t - times[lo]) / dt};
+}
+}  // namespace
+
 Vec3 samplePosition(const std::vector<double>& times, const std::vector<Vec3>& values, double t,
                     const Vec3& fallback) {
   const std::size_t n = std::min(times.size(), values.size());
   if (n == 0) return fallback;
-  if (n == 1 || !(t > times.front())) return values.front();
-  if (t >= times[n - 1]) return values[n - 1];
-  const std::size_t hi = static_cast<std::size_t>(
-      std::upper_bound(times.begin(), times.begin() + n, t) - times.begin());
-  const std::size_t lo = hi - 1;
-  const double dt = times[hi] - times[lo];
-  if (!(dt > 0.0)) return values[hi];
-  const double s = (t - times[lo]) / dt;
-  return values[lo] + s * (values[hi] - values[lo]);
+  const auto [lo, hi, s] = bracket(times, n, t);
+  return lo == hi ? values[lo] : Vec3(values[lo] + s * (values[hi] - values[lo]));
 }
 
 Quat sampleRotation(const std::vector<double>& times, const std::vector<Quat>& values, double t,
                     const Quat& fallback) {
   const std::size_t n = std::min(times.size(), values.size());
   if (n == 0) return fallback;
-  if (n == 1 || !(t > times.front())) return values.front();
-  if (t >= times[n - 1]) return values[n - 1];
-  const std::size_t hi = static_cast<std::size_t>(
-      std::upper_bound(times.begin(), times.begin() + n, t) - times.begin());
-  const std::size_t lo = hi - 1;
-  const double dt = times[hi] - times[lo];
-  if (!(dt > 0.0)) return values[hi];
-  const double s = (t - times[lo]) / dt;
+  const auto [lo, hi, s] = bracket(times, n, t);
   // Eigen's slerp takes the shorter arc (it flips the sign when dot < 0).
-  return values[lo].slerp(s, values[hi]).normalized();
+  return lo == hi ? values[lo] : Quat(values[lo].slerp(s, values[hi]).normalized());
 }
 
 struct AnimationScene::Impl {

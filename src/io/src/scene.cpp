@@ -27,7 +27,10 @@ class SceneParser {
  public:
   SceneParser(std::string_view text, const std::string& file, const std::string& baseDir,
               bool checkFiles)
-      : file_(file), baseDir_(baseDir), checkFiles_(checkFiles), root_(detail::parseToml(text, file)) {
+      : file_(file),
+        baseDir_(baseDir),
+        checkFiles_(checkFiles),
+        root_(detail::parseToml(text, file)) {
     spec_.file = file;
     spec_.dir = baseDir;
     spec_.sourceText = std::string(text);
@@ -112,7 +115,8 @@ class SceneParser {
       if (p.is_relative()) p = fs::path(baseDir_.empty() ? "." : baseDir_) / p;
       p = p.lexically_normal();
       std::error_code ec;
-      if (checkFiles_ && !fs::is_regular_file(p, ec)) r.fail("animation", "no such file: " + p.string());
+      if (checkFiles_ && !fs::is_regular_file(p, ec))
+        r.fail("animation", "no such file: " + p.string());
       spec_.animationFile = p.string();
     }
   }

@@ -126,8 +126,7 @@ std::vector<int> vertexNeighbours(const SheetMesh& mesh, int v) {
 
 std::string validate(const SheetMesh& mesh) {
   const auto n = static_cast<int>(mesh.pattern.size());
-  if (mesh.positions.size() != mesh.pattern.size())
-    return "positions and pattern sizes differ";
+  if (mesh.positions.size() != mesh.pattern.size()) return "positions and pattern sizes differ";
   if (mesh.regionOfTriangle.size() != mesh.triangles.size())
     return "region ids and triangle counts differ";
   for (std::size_t i = 0; i < mesh.pattern.size(); ++i)
@@ -139,8 +138,10 @@ std::string validate(const SheetMesh& mesh) {
       if (v < 0 || v >= n) return "triangle " + std::to_string(t) + " has an out-of-range vertex";
     if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
       return "triangle " + std::to_string(t) + " repeats a vertex";
-    const Vec2 e1 = mesh.pattern[static_cast<std::size_t>(tri[1])] - mesh.pattern[static_cast<std::size_t>(tri[0])];
-    const Vec2 e2 = mesh.pattern[static_cast<std::size_t>(tri[2])] - mesh.pattern[static_cast<std::size_t>(tri[0])];
+    const Vec2 e1 = mesh.pattern[static_cast<std::size_t>(tri[1])] -
+                    mesh.pattern[static_cast<std::size_t>(tri[0])];
+    const Vec2 e2 = mesh.pattern[static_cast<std::size_t>(tri[2])] -
+                    mesh.pattern[static_cast<std::size_t>(tri[0])];
     if (std::abs(e1.x() * e2.y() - e1.y() * e2.x()) <= 1e-18)
       return "triangle " + std::to_string(t) + " is degenerate in the pattern";
     const int r = mesh.regionOfTriangle[t];

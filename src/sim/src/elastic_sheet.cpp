@@ -436,17 +436,6 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
   }
 
   const int n = 3 * freeCount;
-  if (n == 0) {
-    if (!finite(xk)) {
-      why = "non-finite positions";
-      return false;
-    }
-    for (std::size_t i = 0; i < nv; ++i) {
-      v[i] = (xk[i] - xn[i]) / h;
-      x[i] = xk[i];
-    }
-    return true;
-  }
 
   // Rayleigh stiffness damping: projected element stiffness frozen at x_n.
   const double dampScale = beta / h;
@@ -482,8 +471,9 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
   const double tol = params.newtonTolerance * typicalEdge;
   VecX gradQ(n), gradV(n), grad(n), dx(n);
   std::vector<Vec3> disp(nv);
-  bool converged = false;
-  for (int it = 0; it < params.maxNewtonIterations; ++it) {
+  // Nothing to solve when every vertex is pinned: the step is the pins.
+  bool converged = n == 0;
+  for (int it = 0; !converged && it < params.maxNewtonIterations; ++it) {
     // Exact element Hessians first (quadratic convergence); projected to PSD
     // only if the assembled system turns out not to be positive definite.
     evaluate(xk, true, false);

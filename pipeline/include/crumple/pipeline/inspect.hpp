@@ -13,10 +13,10 @@ struct FrameMetrics {
   double time = 0.0;
   std::size_t vertices = 0;
   std::size_t triangles = 0;
-  double cMean = 0.0;       // mean |l - L| / L over edges (paper Table IV, c_mean)
-  double nComp = 0.0;       // share of edges with (L - l) / L > 1% (paper Table IV, n_comp)
-  double maxStrain = 0.0;   // max |l - L| / L over edges
-  double handleError = 0.0; // max distance between a held vertex and its track (m)
+  double cMean = 0.0;        // mean |l - L| / L over edges (paper Table IV, c_mean)
+  double nComp = 0.0;        // share of edges with (L - l) / L > 1% (paper Table IV, n_comp)
+  double maxStrain = 0.0;    // max |l - L| / L over edges
+  double handleError = 0.0;  // max distance between a held vertex and its track (m)
   std::size_t singularVertices = 0;
   std::size_t junctionVertices = 0;
   std::size_t tears = 0;

@@ -24,13 +24,13 @@ struct FrameRange {
 FrameRange parseFrameRange(const std::string& text);
 
 struct ShotOptions {
-  std::string outDir;                  // empty: the scene's [output] dir, else out/<name>
-  std::optional<FrameRange> frames;    // simulate from the scene's first frame up to last;
-                                       // render only this range
-  std::optional<std::uint64_t> seed;   // overrides the scene's seed
-  bool render = true;                  // `run` renders, `simulate` does not
-  std::FILE* log = stderr;             // progress and notes
-  int interactive = -1;                // -1: detect a terminal on `log`
+  std::string outDir;                 // empty: the scene's [output] dir, else out/<name>
+  std::optional<FrameRange> frames;   // simulate from the scene's first frame up to last;
+                                      // render only this range
+  std::optional<std::uint64_t> seed;  // overrides the scene's seed
+  bool render = true;                 // `run` renders, `simulate` does not
+  std::FILE* log = stderr;            // progress and notes
+  int interactive = -1;               // -1: detect a terminal on `log`
 };
 
 // Milliseconds spent per stage, summed over the frames it ran for.

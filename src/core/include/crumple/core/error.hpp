@@ -13,8 +13,7 @@ class InputError : public std::runtime_error {
   explicit InputError(const std::string& message) : std::runtime_error(message) {}
   InputError(const std::string& file, const std::string& problem)
       : std::runtime_error(file + ": " + problem) {}
-  InputError(const std::string& file, long line, const std::string& key,
-             const std::string& problem)
+  InputError(const std::string& file, long line, const std::string& key, const std::string& problem)
       : std::runtime_error(file + ":" + std::to_string(line) + ": '" + key + "': " + problem) {}
 };
 

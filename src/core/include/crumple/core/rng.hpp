@@ -22,7 +22,9 @@ class CounterRng {
                             static_cast<std::uint64_t>(purpose)))) {}
 
   // The index-th 64-bit value of this stream.
-  std::uint64_t bits(std::uint64_t index) const { return mix(key_ + mix(index + 0x632BE59BD9B4E019ULL)); }
+  std::uint64_t bits(std::uint64_t index) const {
+    return mix(key_ + mix(index + 0x632BE59BD9B4E019ULL));
+  }
   // Uniform in [0, 1) with 53 random bits.
   double uniform(std::uint64_t index) const {
     return static_cast<double>(bits(index) >> 11) * 0x1.0p-53;

@@ -16,11 +16,11 @@ namespace crumple::mesh {
 enum class RegionType : std::uint8_t { Flat = 0, Curved = 1 };
 
 struct SheetMesh {
-  std::vector<Vec2> pattern;                 // rest position in the flat pattern (m)
-  std::vector<Vec3> positions;               // current 3D position (m)
+  std::vector<Vec2> pattern;                  // rest position in the flat pattern (m)
+  std::vector<Vec3> positions;                // current 3D position (m)
   std::vector<std::array<int, 3>> triangles;  // counter-clockwise in the pattern
-  std::vector<int> regionOfTriangle;         // region id per triangle
-  std::vector<RegionType> regionTypes;       // type per region id
+  std::vector<int> regionOfTriangle;          // region id per triangle
+  std::vector<RegionType> regionTypes;        // type per region id
 
   std::size_t vertexCount() const { return pattern.size(); }
   std::size_t triangleCount() const { return triangles.size(); }
