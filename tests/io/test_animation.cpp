@@ -9,11 +9,6 @@
 #include "crumple/core/error.hpp"
 #include "crumple/io/animation.hpp"
 
-// assimp 5.2.5's FBX parser leaks a few bytes when a file ends inside a scope
-// (AnimationErrors.MalformedFbx); not ours to fix. LeakSanitizer reads this
-// hook in CRUMPLE_SANITIZE builds; elsewhere it is an unused function.
-extern "C" const char* __lsan_default_suppressions() { return "leak:libassimp.so\n"; }
-
 namespace crumple::io {
 namespace {
 
