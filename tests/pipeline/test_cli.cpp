@@ -195,3 +195,29 @@ TEST_F(BadInput, BadFrameRangeAndCorruptCache) {
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.output.find("junk.pcache"), std::string::npos) << r.output;
 }
+
+TEST(Cli, InspectReportsATruncatedCacheAndAFlippedByte) {
+  TempDir tmp;
+  writeSmallScene(tmp / "scene");
+  ASSERT_EQ(runCrumple("simulate " + (tmp / "scene").string() + " --out " + (tmp / "out").string())
+                .status,
+            0);
+  const auto bytes = readFile(tmp / "out/cache.pcache");
+  // Cut in the middle of the file: the complete frames before the cut are recovered.
+  writeFile(tmp / "cut.pcache", bytes.substr(0, bytes.size() / 2));
+  const auto cut = runCrumple("inspect --json " + (tmp / "cut.pcache").string());
+  EXPECT_EQ(cut.status, 0) << cut.output;
+  EXPECT_EQ(cut.output.find("\"frame_count\":6"), std::string::npos);
+  EXPECT_NE(cut.output.find("\"frame\":1,"), std::string::npos) << cut.output;
+  const auto cutText = runCrumple("inspect " + (tmp / "cut.pcache").string());
+  EXPECT_NE(cutText.output.find("recovered"), std::string::npos) << cutText.output;
+  // A flipped byte near the end (inside the last frame's block or the
+  // footer) is reported; inside a frame, by its CRC with the frame number.
+  auto flipped = bytes;
+  flipped[bytes.size() * 3 / 4] = static_cast<char>(flipped[bytes.size() * 3 / 4] ^ 0x40);
+  writeFile(tmp / "flip.pcache", flipped);
+  const auto bad = runCrumple("inspect " + (tmp / "flip.pcache").string());
+  EXPECT_EQ(bad.status, 2) << bad.output;
+  EXPECT_NE(bad.output.find("CRC"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("frame "), std::string::npos) << bad.output;
+}

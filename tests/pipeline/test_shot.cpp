@@ -292,3 +292,26 @@ TEST(FrameRange, ParsesRangesAndRejectsTheRest) {
   for (const char* bad : {"", "a-b", "3-", "-", "3-1", "1-2-3", "1.5-2", " 1-2"})
     EXPECT_THROW(pipeline::parseFrameRange(bad), InputError) << bad;
 }
+
+TEST(Shot, CameraFromTheAnimationFileIsCachedPerFrame) {
+  // tests/io/data/anim.gltf holds node "Camera" at (0, 0.3, 0.6) looking down
+  // -Z with a vertical field of view of 0.6 rad.
+  TempDir tmp;
+  fs::create_directories(tmp / "s");
+  std::string scene = smallSceneToml("", sourcePath("tests/io/data/anim.gltf"));
+  const auto first = scene.find("[[handles]]");
+  const auto groundAt = scene.find("[ground]");
+  scene = scene.substr(0, first) + "[camera]\nnode = \"Camera\"\nresolution = [160, 120]\n" +
+          scene.substr(groundAt);
+  writeFile(tmp / "s/scene.toml", scene);
+  const auto spec = io::loadScene((tmp / "s/scene.toml").string());
+  const auto report = pipeline::runShot(spec, quiet(tmp / "out", true));
+  const cache::CacheReader reader(report.cachePath);
+  for (std::size_t i = 0; i < reader.frameCount(); ++i) {
+    const auto cam = reader.readFrame(i).camera;
+    EXPECT_LT((cam.position - Vec3(0.0, 0.3, 0.6)).norm(), 1e-6);
+    EXPECT_NEAR(cam.yfov, 0.6, 1e-6);
+    EXPECT_LT((cam.rotation * Vec3(0, 0, -1) - Vec3(0, 0, -1)).norm(), 1e-6);
+  }
+  EXPECT_EQ(report.framesRendered, 6);
+}
