@@ -133,6 +133,27 @@ TEST(ElasticSheet, BitIdenticalForAnyThreadCount) {
   EXPECT_TRUE(bitIdentical(one.first, three.first));
 }
 
+TEST(ElasticSheet, SupernodalPathIsBitIdenticalForAnyThreadCount) {
+  // ~10 000 triangles: large enough for CHOLMOD's supernodal factorisation
+  // (BLAS kernels), which must not make results depend on --threads.
+  const mesh::SheetMesh m = a4Sheet(0.3, 0.005);
+  const PinFunction pins = topCorners(m);
+  auto run = [&](int threads) {
+    setThreadCount(threads);
+    ElasticSheet sheet(m, officePaper(), SimParams{});
+    for (int step = 0; step < 2; ++step) sheet.advance(step / 384.0, 1.0 / 384.0, pins);
+    setThreadCount(1);
+    EXPECT_TRUE(sheet.supernodalFactorization());
+    return sheet.positions();
+  };
+  const auto one = run(1);
+  EXPECT_TRUE(bitIdentical(one, run(2)));
+  // A small sheet stays on the simplicial path.
+  ElasticSheet small(a4Sheet(0.3), officePaper(), SimParams{});
+  small.advance(0.0, 1.0 / 384.0, topCorners(a4Sheet(0.3)));
+  EXPECT_FALSE(small.supernodalFactorization());
+}
+
 TEST(ElasticSheet, PinsFollowAMovingTargetExactly) {
   const mesh::SheetMesh m = a4Sheet(0.0, 0.03);
   const int a = mesh::nearestPatternVertex(m, Vec2(0.0, kHeight));

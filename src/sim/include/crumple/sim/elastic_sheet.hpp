@@ -83,6 +83,9 @@ class ElasticSheet {
   double hingeAngle(std::size_t hinge) const;
   // How many times CHOLMOD's symbolic analysis ran (once per pin set).
   int analyzeCount() const;
+  // True when the system is large enough for CHOLMOD's supernodal LL^T
+  // (simplicial below ~3000 free DOFs).
+  bool supernodalFactorization() const;
   // Mean pattern edge length (m): the length scale of newtonTolerance.
   double typicalEdgeLength() const;
 
