@@ -315,3 +315,20 @@ TEST(Shot, CameraFromTheAnimationFileIsCachedPerFrame) {
   }
   EXPECT_EQ(report.framesRendered, 6);
 }
+
+TEST(PaperPreset, SimulatorDefaultsAreThe70gsmPreset) {
+  const auto preset = io::loadPaperPreset(sourcePath("assets/papers/office-70gsm.toml"));
+  const sim::Material defaults;
+  EXPECT_EQ(defaults.name, preset.name);
+  EXPECT_DOUBLE_EQ(defaults.thickness, preset.thickness);
+  EXPECT_DOUBLE_EQ(defaults.density, preset.density);
+  EXPECT_DOUBLE_EQ(defaults.youngsModulus, preset.youngsModulus);
+  EXPECT_DOUBLE_EQ(defaults.poissonRatio, preset.poissonRatio);
+  // Derived stiffnesses of the preset (Kirchhoff-Love plate).
+  EXPECT_NEAR(defaults.stretchStiffness(), 4.0e9 * 9.0e-5 / (1 - 0.0625), 1e-6);
+  EXPECT_NEAR(defaults.bendingStiffness(), 4.0e9 * 7.29e-13 / (12 * (1 - 0.0625)), 1e-12);
+  // The 90 g/m^2 preset is thicker and stiffer in bending.
+  const auto heavy = io::loadPaperPreset(sourcePath("assets/papers/office-90gsm.toml"));
+  EXPECT_GT(heavy.thickness, preset.thickness);
+  EXPECT_GT(heavy.grammage, preset.grammage);
+}

@@ -5,12 +5,14 @@
 
 namespace crumple::sim {
 
+// Defaults: the 70 g/m^2 office preset (assets/papers/office-70gsm.toml,
+// where each number's source is given).
 struct Material {
-  std::string name;
-  double thickness = 1.0e-4;     // m
-  double density = 700.0;        // kg/m^3
+  std::string name = "office-70gsm";
+  double thickness = 9.0e-5;     // m
+  double density = 777.8;        // kg/m^3
   double youngsModulus = 4.0e9;  // Pa
-  double poissonRatio = 0.3;
+  double poissonRatio = 0.25;
 
   double arealDensity() const { return density * thickness; }  // kg/m^2
   // Membrane (stretch) stiffness E h / (1 - nu^2), N/m.
