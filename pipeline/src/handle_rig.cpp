@@ -103,6 +103,17 @@ HandleRig::HandleRig(const io::SceneSpec& scene, const io::AnimationScene* anima
     const Pose pose = animation->worldPose(spec.node, t0);
     h.vertex = spec.patternPoint ? mesh::nearestPatternVertex(sheet, *spec.patternPoint)
                                  : mesh::nearestVertex(sheet, pose.position);
+    constexpr double kBindTolerance = 1e-6;  // m
+    const auto vertex = static_cast<std::size_t>(h.vertex);
+    if (spec.patternPoint && (sheet.pattern[vertex] - *spec.patternPoint).norm() > kBindTolerance)
+      warnings_.push_back("handle '" + h.name +
+                          "' holds the mesh vertex nearest its pattern point, " +
+                          std::to_string((sheet.pattern[vertex] - *spec.patternPoint).norm()) +
+                          " m away (a finer [sheet] max_edge brings it closer)");
+    if (const double jump = (sheet.positions[vertex] - pose.position).norm(); jump > kBindTolerance)
+      warnings_.push_back(
+          "handle '" + h.name + "': node '" + h.node + "' is " + std::to_string(jump) +
+          " m from its sheet vertex at the first frame; the vertex starts on the node");
     if (auto [it, inserted] = usedVertices.emplace(h.vertex, h.name); !inserted)
       throw InputError(scene.file, "handles '" + it->second + "' and '" + h.name +
                                        "' bind the same sheet vertex " + std::to_string(h.vertex));

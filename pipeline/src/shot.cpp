@@ -275,6 +275,8 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   if (animation)
     for (const auto& w : animation->warnings())
       report.warnings.push_back(animation->file() + ": " + w);
+  report.warnings.insert(report.warnings.end(), rig.bindWarnings().begin(),
+                         rig.bindWarnings().end());
   report.summaryPath = (fs::path(report.outDir) / "summary.json").string();
   std::unique_ptr<FrameRenderer> renderer;
   if (render) {

@@ -1,6 +1,7 @@
 // Scene-level tests: real scenes through the pipeline library.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "crumple/core/error.hpp"
@@ -331,4 +332,38 @@ TEST(PaperPreset, SimulatorDefaultsAreThe70gsmPreset) {
   const auto heavy = io::loadPaperPreset(sourcePath("assets/papers/office-90gsm.toml"));
   EXPECT_GT(heavy.thickness, preset.thickness);
   EXPECT_GT(heavy.grammage, preset.grammage);
+}
+
+TEST(HandleRig, SaysHowFarAHandleIsFromItsVertex) {
+  TempDir tmp;
+  fs::create_directories(tmp / "s");
+  writeFile(tmp / "s/anim.gltf", smallAnimation());
+  // Handle "left" asks for a pattern point between grid vertices (2.5 cm grid).
+  std::string scene = smallSceneToml();
+  scene.replace(scene.find("pattern = [0.0, 10.0]"), 21, "pattern = [1.0, 10.0]");
+  writeFile(tmp / "s/scene.toml", scene);
+  const auto spec = io::loadScene((tmp / "s/scene.toml").string());
+  const auto anim = io::AnimationScene::load(spec.animationFile);
+  const auto sheet = pipeline::buildSheet(spec, &anim);
+  const pipeline::HandleRig rig(spec, &anim, sheet, spec.frameTime(spec.frameStart));
+  auto count = [](const std::vector<std::string>& warnings, const std::string& what) {
+    return std::count_if(warnings.begin(), warnings.end(),
+                         [&](const std::string& w) { return w.find(what) != std::string::npos; });
+  };
+  ASSERT_EQ(count(rig.bindWarnings(), "pattern point"), 1);
+  for (const auto& w : rig.bindWarnings())
+    if (w.find("pattern point") != std::string::npos) {
+      EXPECT_NE(w.find("'left'"), std::string::npos) << w;
+      EXPECT_NE(w.find("0.01"), std::string::npos) << w;  // 1 cm from the corner
+    }
+  // Frame 1 is at t = 1/24 s, when node B has already moved 5.9 mm from the
+  // sheet corner it holds: the vertex jumps onto the track, and a line says so.
+  EXPECT_EQ(count(rig.bindWarnings(), "'right': node 'B' is 0.0058"), 1);
+  // Exact corners bind to their pattern points without a word.
+  writeSmallScene(tmp / "ok");
+  const auto good = io::loadScene((tmp / "ok/scene.toml").string());
+  const auto goodAnim = io::AnimationScene::load(good.animationFile);
+  const pipeline::HandleRig exact(good, &goodAnim, pipeline::buildSheet(good, &goodAnim),
+                                  good.frameTime(good.frameStart));
+  EXPECT_EQ(count(exact.bindWarnings(), "pattern point"), 0);
 }

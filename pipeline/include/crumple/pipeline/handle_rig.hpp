@@ -35,6 +35,11 @@ class HandleRig {
             const mesh::SheetMesh& sheet, double t0);
 
   const std::vector<BoundHandle>& handles() const { return handles_; }
+  // Handles bind to mesh vertices: where the vertex is more than 1e-6 m from
+  // the requested pattern point, or from the node at the first frame (the
+  // vertex then jumps onto the track before the first step), one line says
+  // by how much.
+  const std::vector<std::string>& bindWarnings() const { return warnings_; }
   // Position of the handle's node at time t (world, metres).
   Vec3 target(std::size_t handle, double t) const;
   // Every pinned vertex and where it must be at time t.
@@ -45,6 +50,7 @@ class HandleRig {
  private:
   const io::AnimationScene* animation_;
   std::vector<BoundHandle> handles_;
+  std::vector<std::string> warnings_;
 };
 
 // Neighbour vertices that define the tangent plane at `vertex` (thesis 2.3.1):
