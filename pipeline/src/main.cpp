@@ -85,7 +85,10 @@ int main(int argc, char** argv) {
     cmd->add_option(
         "--frames", a.frames,
         "A-B: simulate from the scene's first frame to B, render A-B (default: the scene's range)");
-    cmd->add_option("--seed", a.seed, "override the scene's seed");
+    cmd->add_option(
+        "--seed", a.seed,
+        "override the scene's seed (recorded in the cache; the elastic model draws no random "
+        "numbers yet)");
     cmd->add_option("--threads", a.threads, "worker threads; results are identical for any count")
         ->check(CLI::Range(1, 256));
   }
@@ -93,12 +96,14 @@ int main(int argc, char** argv) {
       app.add_subcommand("render", "Render frames of a cache (frame-parallel farm work).");
   render->add_option("CACHE", a.cache, "a .pcache file")->required();
   render->add_option("--frames", a.frames, "A-B: frames to render (default: every cached frame)");
-  render
-      ->add_option("--backend", a.backend,
-                   "renderer: osmesa (embree comes with the rendering issue)")
+  render->add_option("--backend", a.backend, "renderer: osmesa (the only backend in this build)")
       ->capture_default_str();
   render->add_option("--out", a.out, "frames folder (default: frames/ beside the cache)");
-  render->add_option("--threads", a.threads, "worker threads")->check(CLI::Range(1, 256));
+  render
+      ->add_option("--threads", a.threads,
+                   "accepted for farm scripts; OSMesa's rasteriser sizes its own threads "
+                   "(LP_NUM_THREADS) and the images are identical either way")
+      ->check(CLI::Range(1, 256));
   auto* inspect =
       app.add_subcommand("inspect", "Print per-frame sizes, strain and handle error of a cache.");
   inspect->add_option("CACHE", a.cache, "a .pcache file")->required();
