@@ -65,6 +65,59 @@
 namespace crumple::sim {
 namespace {
 
+// Element scatter/gather shared by triangles (N = 3, membrane) and hinges
+// (N = 4, bending). Elements are visited in index order, so sums are
+// bit-identical whatever the thread count that computed the element terms.
+template <std::size_t N>
+using ElementVec = Eigen::Matrix<double, 3 * static_cast<int>(N), 1>;
+template <std::size_t N>
+using ElementMat = Eigen::Matrix<double, 3 * static_cast<int>(N), 3 * static_cast<int>(N)>;
+
+// out(free DOFs) += scale * v_e for every element e.
+template <std::size_t N>
+void scatterVectors(const std::vector<std::array<int, N>>& elements,
+                    const std::vector<ElementVec<N>>& v, const std::vector<int>& freeIndex,
+                    double scale, Eigen::VectorXd& out) {
+  for (std::size_t e = 0; e < elements.size(); ++e)
+    for (std::size_t a = 0; a < N; ++a) {
+      const int fi = freeIndex[static_cast<std::size_t>(elements[e][a])];
+      if (fi >= 0)
+        out.segment<3>(3 * fi) += scale * v[e].template segment<3>(3 * static_cast<int>(a));
+    }
+}
+
+// out(free DOFs) += scale * K_e u_e for every element e (u per vertex).
+template <std::size_t N>
+void scatterProducts(const std::vector<std::array<int, N>>& elements,
+                     const std::vector<ElementMat<N>>& k, const std::vector<Vec3>& u,
+                     const std::vector<int>& freeIndex, double scale, Eigen::VectorXd& out) {
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    ElementVec<N> ue;
+    for (std::size_t a = 0; a < N; ++a)
+      ue.template segment<3>(3 * static_cast<int>(a)) = u[static_cast<std::size_t>(elements[e][a])];
+    const ElementVec<N> f = scale * (k[e] * ue);
+    for (std::size_t a = 0; a < N; ++a) {
+      const int fi = freeIndex[static_cast<std::size_t>(elements[e][a])];
+      if (fi >= 0) out.segment<3>(3 * fi) += f.template segment<3>(3 * static_cast<int>(a));
+    }
+  }
+}
+
+// values[offset] += H_e (+ dampScale * D_e) for every element block entry
+// that lands on a free-DOF pair (offsets: (3N)^2 per element, -1 = pinned).
+template <int M>
+void scatterBlocks(const std::vector<Eigen::Matrix<double, M, M>>& hess,
+                   const std::vector<Eigen::Matrix<double, M, M>>* damp, double dampScale,
+                   const std::vector<int>& offsets, double* values) {
+  for (std::size_t e = 0; e < hess.size(); ++e) {
+    const int* off = offsets.data() + e * M * M;
+    const double* hv = hess[e].data();
+    const double* dv = damp ? (*damp)[e].data() : nullptr;
+    for (int i = 0; i < M * M; ++i)
+      if (off[i] >= 0) values[off[i]] += dv ? hv[i] + dampScale * dv[i] : hv[i];
+  }
+}
+
 using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 using Solver = Eigen::CholmodDecomposition<SpMat, Eigen::Lower>;
 using VecX = Eigen::VectorXd;
@@ -471,26 +524,8 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
     hingeDamp = hingeHess;
   }
   auto dampProduct = [&](const std::vector<Vec3>& u, VecX& out) {  // out += beta/h K^_n u
-    for (std::size_t tIdx = 0; tIdx < triangles.size(); ++tIdx) {
-      Vec9 ue;
-      for (int a = 0; a < 3; ++a)
-        ue.segment<3>(3 * a) = u[static_cast<std::size_t>(triangles[tIdx][a])];
-      const Vec9 f = dampScale * (triDamp[tIdx] * ue);
-      for (int a = 0; a < 3; ++a) {
-        const int fi = freeIndex[static_cast<std::size_t>(triangles[tIdx][a])];
-        if (fi >= 0) out.segment<3>(3 * fi) += f.segment<3>(3 * a);
-      }
-    }
-    for (std::size_t k = 0; k < hingeVertices.size(); ++k) {
-      Vec12 ue;
-      for (int a = 0; a < 4; ++a)
-        ue.segment<3>(3 * a) = u[static_cast<std::size_t>(hingeVertices[k][a])];
-      const Vec12 f = dampScale * (hingeDamp[k] * ue);
-      for (int a = 0; a < 4; ++a) {
-        const int fi = freeIndex[static_cast<std::size_t>(hingeVertices[k][a])];
-        if (fi >= 0) out.segment<3>(3 * fi) += f.segment<3>(3 * a);
-      }
-    }
+    scatterProducts(triangles, triDamp, u, freeIndex, dampScale, out);
+    scatterProducts(hingeVertices, hingeDamp, u, freeIndex, dampScale, out);
   };
 
   const double massDiag = 1.0 / (h * h) + alpha / h;
@@ -518,16 +553,8 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
       for (std::size_t i = 0; i < nv; ++i) disp[i] = xk[i] - xn[i];
       dampProduct(disp, gradQ);
     }
-    for (std::size_t tIdx = 0; tIdx < triangles.size(); ++tIdx)
-      for (int a = 0; a < 3; ++a) {
-        const int fi = freeIndex[static_cast<std::size_t>(triangles[tIdx][a])];
-        if (fi >= 0) gradV.segment<3>(3 * fi) += triGrad[tIdx].segment<3>(3 * a);
-      }
-    for (std::size_t k = 0; k < hingeVertices.size(); ++k)
-      for (int a = 0; a < 4; ++a) {
-        const int fi = freeIndex[static_cast<std::size_t>(hingeVertices[k][a])];
-        if (fi >= 0) gradV.segment<3>(3 * fi) += hingeGrad[k].segment<3>(3 * a);
-      }
+    scatterVectors(triangles, triGrad, freeIndex, 1.0, gradV);
+    scatterVectors(hingeVertices, hingeGrad, freeIndex, 1.0, gradV);
     grad = gradQ + gradV;
     if (!grad.allFinite()) {
       why = "non-finite forces";
@@ -545,20 +572,8 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
         for (int c = 0; c < 3; ++c)
           values[diagOffset[static_cast<std::size_t>(3 * fi + c)]] += mass[i] * massDiag;
       }
-      for (std::size_t tIdx = 0; tIdx < triangles.size(); ++tIdx) {
-        const int* off = triOffset.data() + tIdx * 81;
-        const double* hv = triHess[tIdx].data();
-        const double* dv = beta > 0.0 ? triDamp[tIdx].data() : nullptr;
-        for (int e = 0; e < 81; ++e)
-          if (off[e] >= 0) values[off[e]] += dv ? hv[e] + dampScale * dv[e] : hv[e];
-      }
-      for (std::size_t k = 0; k < hingeVertices.size(); ++k) {
-        const int* off = hingeOffset.data() + k * 144;
-        const double* hv = hingeHess[k].data();
-        const double* dv = beta > 0.0 ? hingeDamp[k].data() : nullptr;
-        for (int e = 0; e < 144; ++e)
-          if (off[e] >= 0) values[off[e]] += dv ? hv[e] + dampScale * dv[e] : hv[e];
-      }
+      scatterBlocks(triHess, beta > 0.0 ? &triDamp : nullptr, dampScale, triOffset, values);
+      scatterBlocks(hingeHess, beta > 0.0 ? &hingeDamp : nullptr, dampScale, hingeOffset, values);
       return Eigen::Map<const VecX>(values, matrix.nonZeros()).allFinite();
     };
     if (!assemble()) {
