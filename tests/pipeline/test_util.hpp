@@ -208,3 +208,12 @@ inline void writeSmallScene(const fs::path& dir) {
 }
 
 }  // namespace crumple::testing
+
+namespace crumple::testing {
+// A measured value for RecordProperty (gtest XML): scientific notation.
+inline std::string sci(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3e", v);
+  return buf;
+}
+}  // namespace crumple::testing
