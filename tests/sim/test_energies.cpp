@@ -5,8 +5,10 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <numbers>
+#include <string>
 
 #include "crumple/core/rng.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
@@ -19,6 +21,12 @@ using namespace crumple::sim;
 namespace {
 
 constexpr double kTolerance = 1e-5;
+
+std::string sci(double v) {  // measured figures for the gtest XML report
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3e", v);
+  return buf;
+}
 
 // norm(analytic - fd) / max(norm(fd), floor)
 template <typename A, typename B>
@@ -151,6 +159,7 @@ TEST(MembraneEnergy, UniaxialStretchMatchesPlaneStressStVK) {
 
 TEST(MembraneEnergy, GradientAndHessianMatchFiniteDifferences) {
   const MembraneModuli mod = membraneModuli(officePaper());
+  double worstGradient = 0.0, worstHessian = 0.0;
   for (std::uint64_t seed = 1; seed <= 8; ++seed) {
     // Stretched (strain ~ 10%) and compressed / inverted configurations.
     const double strain = seed % 2 == 0 ? 0.1 : 0.5;
@@ -169,10 +178,14 @@ TEST(MembraneEnergy, GradientAndHessianMatchFiniteDifferences) {
     const double eps = 1e-7;  // coordinates ~ 2 cm
     const Vec9 gfd = fdGradient<9>(energy, c.x, eps);
     const Mat9 hfd = fdHessian<9>(gradient, c.x, eps);
+    worstGradient = std::max(worstGradient, relativeError(g, gfd, 1e-12));
+    worstHessian = std::max(worstHessian, relativeError(h, hfd, 1e-12));
     EXPECT_LT(relativeError(g, gfd, 1e-12), kTolerance) << "seed " << seed;
     EXPECT_LT(relativeError(h, hfd, 1e-12), kTolerance) << "seed " << seed;
     EXPECT_LT((h - h.transpose()).norm(), 1e-12 * h.norm());
   }
+  RecordProperty("worst_gradient_relative_error", sci(worstGradient));
+  RecordProperty("worst_hessian_relative_error", sci(worstHessian));
 }
 
 TEST(DihedralAngle, SignConventionAndRange) {
@@ -198,6 +211,7 @@ TEST(BendingEnergy, GradientAndHessianMatchFiniteDifferences) {
   const Case cases[] = {{0.0, 0.0}, {0.3, 0.0},  {-0.7, 0.2}, {1.2, -0.5},
                         {2.0, 0.3}, {-2.0, 0.0}, {2.1, 2.0},  {-2.2, -1.0}};
   std::uint64_t seed = 100;
+  double worstGradient = 0.0, worstHessian = 0.0;
   for (const Case& c : cases) {
     for (int rep = 0; rep < 3; ++rep, ++seed) {
       const Vec12 x = randomHinge(seed, c.phi, 0.05);
@@ -220,6 +234,8 @@ TEST(BendingEnergy, GradientAndHessianMatchFiniteDifferences) {
       const Vec12 gfd = fdGradient<12>(energy, x, eps);
       const Mat12 hfd = fdHessian<12>(gradient, x, eps);
       // Floors: the flat, rest-angle-0 case has a zero gradient.
+      worstGradient = std::max(worstGradient, relativeError(g, gfd, 1e-10));
+      worstHessian = std::max(worstHessian, relativeError(h, hfd, 1e-10));
       EXPECT_LT(relativeError(g, gfd, 1e-10), kTolerance) << "phi " << c.phi << " seed " << seed;
       EXPECT_LT(relativeError(h, hfd, 1e-10), kTolerance) << "phi " << c.phi << " seed " << seed;
 
@@ -244,6 +260,8 @@ TEST(BendingEnergy, GradientAndHessianMatchFiniteDifferences) {
                 1e-9 * ga.norm());
     }
   }
+  RecordProperty("worst_gradient_relative_error", sci(worstGradient));
+  RecordProperty("worst_hessian_relative_error", sci(worstHessian));
 }
 
 TEST(ProjectToPsd, ClampsNegativeEigenvalues) {
