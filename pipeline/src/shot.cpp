@@ -277,6 +277,8 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
       report.warnings.push_back(animation->file() + ": " + w);
   report.warnings.insert(report.warnings.end(), rig.bindWarnings().begin(),
                          rig.bindWarnings().end());
+  // Said now as well as in the summary: they often explain a failure that follows.
+  for (const auto& w : report.warnings) std::fprintf(options.log, "warning: %s\n", w.c_str());
   report.summaryPath = (fs::path(report.outDir) / "summary.json").string();
   std::unique_ptr<FrameRenderer> renderer;
   if (render) {
@@ -368,7 +370,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
           report.halvings += stats.halvings;
           ++report.substeps;
         } catch (const NumericalError& e) {
-          throw NumericalError(e.stage(), frame, e.what());
+          throw NumericalError(e.stage(), frame, e.problem());
         }
       }
       report.stages["elastic"].totalMs += msSince(start);

@@ -24,16 +24,22 @@ class NumericalError : public std::runtime_error {
       : std::runtime_error("frame " + std::to_string(frame) + ", stage '" + stage +
                            "': " + problem),
         stage_(stage),
+        problem_(problem),
         frame_(frame) {}
   // Without a frame (a module that does not know it); the pipeline rethrows
   // with the frame filled in.
   NumericalError(const std::string& stage, const std::string& problem)
-      : std::runtime_error("stage '" + stage + "': " + problem), stage_(stage), frame_(-1) {}
+      : std::runtime_error("stage '" + stage + "': " + problem),
+        stage_(stage),
+        problem_(problem),
+        frame_(-1) {}
   const std::string& stage() const { return stage_; }
+  const std::string& problem() const { return problem_; }
   int frame() const { return frame_; }
 
  private:
   std::string stage_;
+  std::string problem_;
   int frame_;
 };
 
