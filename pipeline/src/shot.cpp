@@ -471,6 +471,14 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
   j.key("vertices").value(r.vertices);
   j.key("triangles").value(r.triangles);
   j.key("substeps_per_frame").value(scene.substeps);
+  const sim::Material paper = materialOf(scene.paper);
+  j.key("paper").beginObject();
+  j.key("preset").value(paper.name);
+  j.key("thickness_m").value(paper.thickness);
+  j.key("areal_density_kg_m2").value(paper.arealDensity());
+  j.key("stretch_stiffness_N_m").value(paper.stretchStiffness());
+  j.key("bending_stiffness_N_m").value(paper.bendingStiffness());
+  j.endObject();
   // What ran: a scene pays only for what it uses (DESIGN.md "Invariants").
   j.key("ran").beginObject();
   j.key("elastic").value(true);

@@ -48,6 +48,9 @@ TEST(Cli, RunWritesCacheFramesSummaryAndProgressLines) {
   const auto summary = readFile(tmp / "out/summary.json");
   EXPECT_NE(summary.find("\"elastic\""), std::string::npos);
   EXPECT_NE(summary.find("\"tearing\":false"), std::string::npos);
+  // The derived stiffnesses of the preset: E h / (1 - nu^2), E h^3 / (12 (1 - nu^2)).
+  EXPECT_NE(summary.find("\"stretch_stiffness_N_m\":384000"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"bending_stiffness_N_m\":0.0002592"), std::string::npos) << summary;
 }
 
 TEST(Cli, InspectJsonHasTheDocumentedKeys) {
