@@ -7,6 +7,11 @@ find_package(assimp 5.2 REQUIRED CONFIG)
 find_package(PNG REQUIRED)
 find_package(CLI11 REQUIRED CONFIG)
 find_package(tomlplusplus REQUIRED CONFIG)  # target tomlplusplus::tomlplusplus
+# CGAL 5.5 is header-only on Debian; CGAL::CGAL carries Boost's headers, GMP,
+# MPFR and -frounding-math (needed by its filtered predicates). Link it
+# PRIVATE: only src/mesh/src/delaunay.cpp includes CGAL.
+set(CGAL_DO_NOT_WARN_ABOUT_CMAKE_BUILD_TYPE TRUE)
+find_package(CGAL 5.5 REQUIRED CONFIG)
 # OSMesa only: linking libGL as well turns every GL call into a no-op.
 pkg_check_modules(OSMESA REQUIRED IMPORTED_TARGET osmesa)
 

@@ -8,6 +8,7 @@ PACKAGES=(
   libeigen3-dev libsuitesparse-dev libopenblas0
   libassimp-dev libosmesa6-dev libpng-dev
   libtomlplusplus-dev libcli11-dev
+  libcgal-dev libgmp-dev libmpfr-dev
   libgtest-dev libbenchmark-dev
 )
 

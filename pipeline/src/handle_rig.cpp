@@ -122,6 +122,7 @@ HandleRig::HandleRig(const io::SceneSpec& scene, const io::AnimationScene* anima
       h.releaseTime = *spec.releaseTime;
     }
     if (spec.tangentControl) {
+      h.tangentCount = spec.tangentVertices;
       h.tangentVertices = tangentNeighbours(sheet, h.vertex, spec.tangentVertices);
       h.bindRotation = pose.rotation;
       const Vec3 base = sheet.positions[static_cast<std::size_t>(h.vertex)];
@@ -152,6 +153,25 @@ void HandleRig::pins(double t, std::vector<sim::Pin>& out) const {
     out.push_back({h.vertex, pose.position});
     for (std::size_t k = 0; k < h.tangentVertices.size(); ++k)
       out.push_back({h.tangentVertices[k], pose.position + pose.rotation * h.tangentOffsets[k]});
+  }
+}
+
+void HandleRig::rebindTangents(const mesh::SheetMesh& sheet,
+                               const std::function<Vec3(const Vec2&)>& rest) {
+  std::vector<char> held(sheet.vertexCount(), 0);
+  for (const auto& h : handles_) held[static_cast<std::size_t>(h.vertex)] = 1;
+  for (auto& h : handles_) {
+    if (h.tangentCount < 0) continue;
+    h.tangentVertices.clear();
+    h.tangentOffsets.clear();
+    const Vec3 base = rest(sheet.pattern[static_cast<std::size_t>(h.vertex)]);
+    for (int n : tangentNeighbours(sheet, h.vertex, h.tangentCount)) {
+      if (held[static_cast<std::size_t>(n)]) continue;  // another handle's vertex
+      held[static_cast<std::size_t>(n)] = 1;
+      h.tangentVertices.push_back(n);
+      h.tangentOffsets.push_back(h.bindRotation.conjugate() *
+                                 (rest(sheet.pattern[static_cast<std::size_t>(n)]) - base));
+    }
   }
 }
 

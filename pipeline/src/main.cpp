@@ -29,6 +29,7 @@ struct Args {
   int threads = 1;
   std::string backend = "osmesa";
   bool json = false;
+  bool debugStructure = false;
 };
 
 int runOrSimulate(const Args& a, bool render) {
@@ -39,6 +40,7 @@ int runOrSimulate(const Args& a, bool render) {
   if (!a.frames.empty()) options.frames = pipeline::parseFrameRange(a.frames);
   options.seed = a.seed;
   options.render = render;
+  options.debugStructure = a.debugStructure;
   const auto report = pipeline::runShot(scene, options);
   std::fputs(pipeline::summaryText(report).c_str(), stdout);
   return 0;
@@ -52,6 +54,7 @@ int renderCommand(const Args& a) {
   pipeline::RenderOptions options;
   if (!a.frames.empty()) options.frames = pipeline::parseFrameRange(a.frames);
   options.framesDir = a.out;
+  options.debugStructure = a.debugStructure;
   const auto report = pipeline::renderCache(a.cache, options);
   std::printf("%d frames rendered (osmesa), %.2f ms/frame\n  frames:  %s/\n", report.framesRendered,
               report.cost.msPerFrame(), report.framesDir.c_str());
@@ -87,13 +90,19 @@ int main(int argc, char** argv) {
         "A-B: simulate from the scene's first frame to B, render A-B (default: the scene's range)");
     cmd->add_option(
         "--seed", a.seed,
-        "override the scene's seed (recorded in the cache; the elastic model draws no random "
-        "numbers yet)");
+        "override the scene's seed (it places the crumpling model's singular vertices; the "
+        "elastic model draws no random numbers)");
     cmd->add_option("--threads", a.threads, "worker threads; results are identical for any count")
         ->check(CLI::Range(1, 256));
   }
+  run->add_flag(
+      "--debug-structure", a.debugStructure,
+      "draw the crumpling model's structure: flat regions green, curved regions magenta "
+      "with their rulings, singular vertices red, junction vertices yellow, handles black");
   auto* render =
       app.add_subcommand("render", "Render frames of a cache (frame-parallel farm work).");
+  render->add_flag("--debug-structure", a.debugStructure,
+                   "draw the crumpling model's structure (see `run --help`)");
   render->add_option("CACHE", a.cache, "a .pcache file")->required();
   render->add_option("--frames", a.frames, "A-B: frames to render (default: every cached frame)");
   render->add_option("--backend", a.backend, "renderer: osmesa (the only backend in this build)")

@@ -6,15 +6,19 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string_view>
 
 #include "crumple/core/error.hpp"
 #include "crumple/core/progress.hpp"
 #include "crumple/exporters/png.hpp"
+#include "crumple/paper/hybrid_sheet.hpp"
+#include "crumple/paper/initial_sheet.hpp"
 #include "crumple/pipeline/handle_rig.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/render/osmesa_renderer.hpp"
@@ -97,9 +101,10 @@ mesh::SheetMesh sheetOfFrame(const cache::FrameRecord& frame) {
 // Renders cached frames with one OSMesa context, reused across frames.
 class FrameRenderer {
  public:
-  FrameRenderer(const io::SceneSpec& scene, std::string framesDir)
+  FrameRenderer(const io::SceneSpec& scene, std::string framesDir, bool debugStructure)
       : scene_(scene),
         framesDir_(std::move(framesDir)),
+        debugStructure_(debugStructure),
         renderer_(scene.camera.width, scene.camera.height),
         texture_(render::makeRuledPaperTexture(512, 512)) {}
 
@@ -113,16 +118,91 @@ class FrameRenderer {
       hi = hi.cwiseMax(p);
     }
     view.paper.textureSize = (hi - lo).cwiseMax(Vec2::Constant(1e-6));
-    const auto image = renderer_.render(view, sheetOfFrame(frame));
+    const mesh::SheetMesh sheet = sheetOfFrame(frame);
+    if (debugStructure_) {
+      const render::StructureOverlay overlay = structureOverlay(frame);
+      const auto image = renderer_.render(view, sheet, &overlay);
+      exporters::writePng((fs::path(framesDir_) / frameFileName(frame.frame)).string(), image);
+      return;
+    }
+    const auto image = renderer_.render(view, sheet);
     exporters::writePng((fs::path(framesDir_) / frameFileName(frame.frame)).string(), image);
   }
 
  private:
+  // The structure view (paper Fig. 2): flat regions green, curved regions
+  // magenta with their rulings, singular vertices red, junction vertices
+  // yellow, handles black.
+  static render::StructureOverlay structureOverlay(const cache::FrameRecord& frame) {
+    const render::StructurePalette palette;
+    render::StructureOverlay overlay;
+    for (int region : frame.regionOfTriangle) {
+      const bool curved = static_cast<std::size_t>(region) < frame.regionTypes.size() &&
+                          frame.regionTypes[static_cast<std::size_t>(region)] ==
+                              static_cast<std::uint8_t>(mesh::RegionType::Curved);
+      overlay.triangleColors.push_back(curved ? palette.curved : palette.flat);
+    }
+    const auto at = [&](int v) { return frame.positions[static_cast<std::size_t>(v)]; };
+    for (const auto& r : frame.rulings)
+      overlay.lines.push_back({at(r[0]), at(r[1]), palette.ruling});
+    for (int v : frame.junctionVertices) overlay.points.push_back({at(v), palette.junction});
+    for (int v : frame.singularVertices) overlay.points.push_back({at(v), palette.singular});
+    for (int v : frame.handleVertices)
+      if (v >= 0) overlay.points.push_back({at(v), palette.handle});
+    return overlay;
+  }
+
   const io::SceneSpec& scene_;
   std::string framesDir_;
+  bool debugStructure_ = false;
   render::OsmesaRenderer renderer_;
   ImageRGBA8 texture_;
 };
+
+paper::CrumpleParams crumpleParamsOf(const io::HybridSpec& h) {
+  paper::CrumpleParams p;
+  p.rhoBound = h.rhoBound;
+  p.rhoInt = h.rhoInt;
+  p.theta0 = h.theta0;
+  p.thetaLow = h.thetaLow;
+  p.thetaHigh = h.thetaHigh;
+  p.epsBlaschke = h.epsBlaschke;
+  p.epsC = h.epsC;
+  p.sigma = h.sigma;
+  p.thetaRest = h.thetaRest;
+  p.damage = h.damage;
+  p.isometryIterations = h.isometryIterations;
+  // Region invariants after every geometric step: always in debug builds,
+  // on request (CRUMPLE_CHECK_INVARIANTS=1) in release builds.
+  if (const char* env = std::getenv("CRUMPLE_CHECK_INVARIANTS"); env != nullptr && env[0] == '1')
+    p.checkInvariants = true;
+  return p;
+}
+
+// The hybrid model's starting S_G: the rectangle with a vertex at every
+// handle's pattern point (or the sheet point under its node at the first
+// frame), so handles hold exactly the point they name.
+paper::InitialSheet hybridStartSheet(const io::SceneSpec& scene,
+                                     const io::AnimationScene* animation, double t0) {
+  const auto& s = scene.sheet;
+  if (s.kind != io::SheetSpec::Kind::Rectangle)
+    throw InputError(scene.file,
+                     "[model] type = \"hybrid\" needs a rectangular [sheet] (width, height); "
+                     "pattern_mesh sheets run with the elastic model only");
+  const Vec3 u = s.uAxis.normalized();
+  const Vec3 v = s.vAxis.normalized();
+  std::vector<Vec2> points;
+  for (const auto& h : scene.handles) {
+    if (h.patternPoint) {
+      points.push_back(*h.patternPoint);
+    } else if (animation != nullptr && animation->hasNode(h.node)) {
+      const Vec3 x = animation->worldPose(h.node, t0).position - s.origin;
+      points.push_back(
+          Vec2(std::clamp(x.dot(u), 0.0, s.width), std::clamp(x.dot(v), 0.0, s.height)));
+    }
+  }
+  return paper::makeFlatSheet(s.width, s.height, points, s.origin, u, v);
+}
 
 void validateRange(const io::SceneSpec& scene, const FrameRange& range) {
   if (range.first < scene.frameStart || range.last > scene.frameEnd)
@@ -264,10 +344,37 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     animation = std::make_unique<io::AnimationScene>(io::AnimationScene::load(scene.animationFile));
     io::checkAnimationNodes(scene, *animation);
   }
-  mesh::SheetMesh sheet = buildSheet(scene, animation.get());
   const double t0 = frameTime(scene, scene.frameStart);
-  const HandleRig rig(scene, animation.get(), sheet, t0);
+  const bool hybridModel = scene.model.type == io::ModelSpec::Type::Hybrid;
+  sim::SimParams params;
+  params.gravity = scene.sim.gravity;
+  params.massDamping = scene.sim.massDamping;
+  params.stiffnessDamping = scene.sim.stiffnessDamping;
+  params.maxNewtonIterations = scene.sim.maxNewtonIterations;
+  const std::uint64_t seed = options.seed.value_or(scene.seed);
+  std::unique_ptr<paper::HybridSheet> hybrid;
+  mesh::SheetMesh sheet;
+  if (hybridModel) {
+    hybrid = std::make_unique<paper::HybridSheet>(hybridStartSheet(scene, animation.get(), t0).mesh,
+                                                  materialOf(scene.paper), params,
+                                                  crumpleParamsOf(scene.model.hybrid), seed);
+    sheet = hybrid->physical().mesh;
+  } else {
+    sheet = buildSheet(scene, animation.get());
+  }
+  HandleRig rig(scene, animation.get(), sheet, t0);
   rig.snap(t0, sheet.positions);
+  if (hybrid) {
+    std::vector<sim::Pin> start;
+    rig.pins(t0, start);
+    hybrid->placeVertices(start);
+    const Vec3 origin = scene.sheet.origin;
+    const Vec3 u = scene.sheet.uAxis.normalized();
+    const Vec3 v = scene.sheet.vAxis.normalized();
+    hybrid->setRebuildCallback([&rig, origin, u, v](const mesh::SheetMesh& sp) {
+      rig.rebindTangents(sp, [&](const Vec2& p) { return Vec3(origin + p.x() * u + p.y() * v); });
+    });
+  }
   for (int f = scene.frameStart; f <= range.last; ++f)
     (void)cameraAt(scene, animation.get(), frameTime(scene, f));
   prepareOutputDir(report.outDir, "output");
@@ -284,22 +391,18 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   if (render) {
     report.framesDir = (fs::path(report.outDir) / "frames").string();
     prepareOutputDir(report.framesDir, "frames");
-    renderer = std::make_unique<FrameRenderer>(scene, report.framesDir);
+    renderer = std::make_unique<FrameRenderer>(scene, report.framesDir, options.debugStructure);
   }
 
-  sim::SimParams params;
-  params.gravity = scene.sim.gravity;
-  params.massDamping = scene.sim.massDamping;
-  params.stiffnessDamping = scene.sim.stiffnessDamping;
-  params.maxNewtonIterations = scene.sim.maxNewtonIterations;
-  sim::ElasticSheet elastic(sheet, materialOf(scene.paper), params);
+  std::optional<sim::ElasticSheet> elastic;
+  if (!hybrid) elastic.emplace(sheet, materialOf(scene.paper), params);
 
   cache::CacheHeader header;
   header.fps = scene.fps;
   header.frameStart = scene.frameStart;
   header.frameEnd = range.last;
   header.substeps = scene.substeps;
-  header.seed = options.seed.value_or(scene.seed);
+  header.seed = seed;
   header.sceneName = scene.name;
   header.sceneFile = scene.file;
   header.sceneText = scene.sourceText;
@@ -329,7 +432,31 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     const double t = frameTime(scene, frame);
     record.frame = frame;
     record.time = t;
-    record.positions = elastic.positions();
+    if (hybrid) {
+      // S_P of this frame (its topology changes as the sheet crumples) and
+      // the structure of S_G (paper Fig. 2), whose vertices are S_P's first.
+      const mesh::SheetMesh& sp = hybrid->physical().mesh;
+      record.triangles = sp.triangles;
+      record.regionOfTriangle = sp.regionOfTriangle;
+      record.regionTypes.clear();
+      for (auto type : sp.regionTypes)
+        record.regionTypes.push_back(static_cast<std::uint8_t>(type));
+      record.pattern = sp.pattern;
+      record.positions = sp.positions;
+      const paper::GeometricMesh& sg = hybrid->geometric();
+      record.singularVertices.clear();
+      for (std::size_t i = 0; i < sg.vertices.size(); ++i)
+        if (sg.vertices[i].singular) record.singularVertices.push_back(static_cast<int>(i));
+      record.junctionVertices = paper::junctionVertices(sg);
+      record.rulings.clear();
+      for (const auto& region : sg.regions)
+        for (const auto& r : region.rulings) record.rulings.push_back({r.a, r.b});
+      report.maxTriangles = std::max(report.maxTriangles, sp.triangleCount());
+      report.singularVertices = hybrid->singularVertexCount();
+      report.interiorSingularVertices = hybrid->interiorSingularVertexCount();
+    } else {
+      record.positions = elastic->positions();
+    }
     record.handleVertices.clear();
     record.handleTargets.clear();
     for (std::size_t h = 0; h < rig.handles().size(); ++h) {
@@ -346,6 +473,9 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     const auto m = measureFrame(record);
     report.maxHandleError = std::max(report.maxHandleError, m.handleError);
     report.maxStrain = std::max(report.maxStrain, m.maxStrain);
+    report.meanCMean += m.cMean;
+    report.maxCMean = std::max(report.maxCMean, m.cMean);
+    report.maxNComp = std::max(report.maxNComp, m.nComp);
     ++report.framesSimulated;
     if (renderer && frame >= range.first) {
       start = Clock::now();
@@ -360,12 +490,32 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   try {
     emit(scene.frameStart);
     for (int frame = scene.frameStart + 1; frame <= range.last; ++frame) {
+      if (hybrid) {
+        // One animation step per frame (paper Fig. 16): the elastic substeps,
+        // then the geometric step, cones, S_P rebuild and isometry.
+        const double t = frameTime(scene, frame - 1);
+        const auto stats = hybrid->advance(t, 1.0 / scene.fps, scene.substeps, pins, frame);
+        report.newtonIterations += stats.elastic.newtonIterations;
+        report.halvings += stats.elastic.halvings;
+        report.substeps += scene.substeps;
+        const std::pair<const char*, double> stages[] = {{"elastic", stats.ms.elastic},
+                                                         {"geometric", stats.ms.geometric},
+                                                         {"cones", stats.ms.cones},
+                                                         {"rebuild", stats.ms.rebuild},
+                                                         {"isometry", stats.ms.isometry}};
+        for (const auto& [name, ms] : stages) {
+          report.stages[name].totalMs += ms;
+          report.stages[name].frames += 1;
+        }
+        emit(frame);
+        continue;
+      }
       const auto start = Clock::now();
       for (int s = 0; s < scene.substeps; ++s) {
         // Substep s of frame f starts at ((f - 1) * substeps + s) * dt.
         const double t = static_cast<double>((frame - 1) * scene.substeps + s) * dt;
         try {
-          const auto stats = elastic.advance(t, dt, pins);
+          const auto stats = elastic->advance(t, dt, pins);
           report.newtonIterations += stats.newtonIterations;
           report.halvings += stats.halvings;
           ++report.substeps;
@@ -386,6 +536,8 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   }
   progress.finish();
   writer.close();
+  report.hybrid = hybridModel;
+  if (report.framesSimulated > 0) report.meanCMean /= report.framesSimulated;
   if (report.halvings > 0)
     report.warnings.push_back("the elastic solve halved its substep " +
                               std::to_string(report.halvings) +
@@ -418,7 +570,7 @@ RenderReport renderCache(const std::string& cachePath, const RenderOptions& opti
                          std::to_string(lastCached));
   }
   prepareOutputDir(report.framesDir, "frames");
-  FrameRenderer renderer(scene, report.framesDir);
+  FrameRenderer renderer(scene, report.framesDir, options.debugStructure);
   Progress progress("crumple render", range.last - range.first + 1, options.log,
                     options.interactive);
   for (int f = range.first; f <= range.last; ++f) {
@@ -482,7 +634,7 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
   // What ran: a scene pays only for what it uses (DESIGN.md "Invariants").
   j.key("ran").beginObject();
   j.key("elastic").value(true);
-  j.key("crumpling_model").value(false);
+  j.key("crumpling_model").value(r.hybrid);
   j.key("contacts").value(false);
   j.key("self_contact").value(false);
   j.key("tearing").value(false);
@@ -496,6 +648,17 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
   j.key("substep_halvings").value(static_cast<long long>(r.halvings));
   j.key("max_handle_error").value(r.maxHandleError);
   j.key("max_edge_strain").value(r.maxStrain);
+  if (r.hybrid) {
+    // Paper Table IV measures, as fractions (c_mean 0.005 = 0.5 %).
+    j.key("crumpling").beginObject();
+    j.key("c_mean_mean").value(r.meanCMean);
+    j.key("c_mean_max").value(r.maxCMean);
+    j.key("n_comp_max").value(r.maxNComp);
+    j.key("singular_vertices").value(r.singularVertices);
+    j.key("interior_singular_vertices").value(r.interiorSingularVertices);
+    j.key("max_triangles").value(static_cast<long long>(r.maxTriangles));
+    j.endObject();
+  }
   j.key("warnings").beginArray();
   for (const auto& w : r.warnings) j.value(w);
   j.endArray();

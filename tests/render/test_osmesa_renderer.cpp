@@ -19,6 +19,7 @@
 #include "crumple/render/osmesa_renderer.hpp"
 #include "png_io.hpp"
 #include "render_test_scenes.hpp"
+#include "render_test_util.hpp"
 
 namespace crumple::render {
 namespace {
@@ -28,31 +29,14 @@ using test::bentSceneSheet;
 using test::flatSheet;
 using test::kSheetHeight;
 using test::kSheetWidth;
+using test::maybeDump;
+using test::pixelAt;
 using test::topCamera;
-
-bool envFlag(const char* name) {
-  const char* v = std::getenv(name);
-  return v != nullptr && *v != '\0' && std::string(v) != "0";
-}
-
-void maybeDump(const std::string& name, const ImageRGBA8& img) {
-  if (envFlag("CRUMPLE_RENDER_DUMP"))
-    test::writePng(std::string(CRUMPLE_RENDER_OUT_DIR) + "/" + name + ".png", img);
-}
 
 ImageRGBA8 whiteTexture() {
   ImageRGBA8 t(1, 1);
   std::fill(t.pixels.begin(), t.pixels.end(), std::uint8_t{255});
   return t;
-}
-
-// The pixel whose area contains the projection of a world point.
-const std::uint8_t* pixelAt(const ImageRGBA8& img, const Camera& cam, const Vec3& world) {
-  const auto p = projectToPixel(cam, world);
-  EXPECT_TRUE(p.has_value());
-  const int x = std::clamp(static_cast<int>(std::floor(p->x())), 0, img.width - 1);
-  const int y = std::clamp(static_cast<int>(std::floor(p->y())), 0, img.height - 1);
-  return img.at(x, y);
 }
 
 double luma(const std::uint8_t* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
@@ -382,11 +366,6 @@ TEST(OsmesaRenderer, PaperLyingOnTheGroundIsVisible) {
   EXPECT_EQ(reddish, checked);
 }
 
-std::vector<std::uint8_t> readBytes(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(f), {});
-}
-
 TEST(OsmesaRenderer, IdenticalBytesAcrossProcessesAndThreadCounts) {
   const int w = 160, h = 120;
   OsmesaRenderer r(w, h);
@@ -399,7 +378,7 @@ TEST(OsmesaRenderer, IdenticalBytesAcrossProcessesAndThreadCounts) {
                             CRUMPLE_RENDER_DUMP_EXE + "' '" + out + "' " + std::to_string(w) + " " +
                             std::to_string(h);
     ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
-    EXPECT_EQ(readBytes(out), here.pixels) << "LP_NUM_THREADS=" << threads;
+    EXPECT_EQ(test::readBytes(out), here.pixels) << "LP_NUM_THREADS=" << threads;
   }
 }
 
@@ -408,29 +387,7 @@ TEST(OsmesaRenderer, GoldenBentSheet) {
   OsmesaRenderer r(w, h);
   const ImageRGBA8 img = r.render(bentScene(w, h), bentSceneSheet());
   maybeDump("bent_sheet", img);
-  const std::string golden = std::string(CRUMPLE_RENDER_GOLDEN_DIR) + "/bent_sheet.png";
-  if (envFlag("CRUMPLE_BLESS")) {
-    test::writePng(golden, img);
-    GTEST_SKIP() << "CRUMPLE_BLESS: rewrote " << golden;
-  }
-  ASSERT_TRUE(std::filesystem::exists(golden))
-      << golden << " is missing; run with CRUMPLE_BLESS=1 to create it";
-  const ImageRGBA8 ref = test::readPng(golden);
-  ASSERT_EQ(ref.width, w);
-  ASSERT_EQ(ref.height, h);
-  if (ref.pixels != img.pixels) {
-    int differing = 0, maxDiff = 0;
-    for (std::size_t i = 0; i < img.pixels.size(); ++i) {
-      const int d = std::abs(int(img.pixels[i]) - int(ref.pixels[i]));
-      differing += d != 0;
-      maxDiff = std::max(maxDiff, d);
-    }
-    const std::string actual = std::string(CRUMPLE_RENDER_OUT_DIR) + "/bent_sheet.actual.png";
-    test::writePng(actual, img);
-    FAIL() << differing << " bytes differ from " << golden << " (max difference " << maxDiff
-           << "); the render is in " << actual
-           << ". If the change is intended, re-bless with CRUMPLE_BLESS=1.";
-  }
+  test::expectMatchesGolden("bent_sheet", img);
 }
 
 TEST(OsmesaRenderer, PngRoundTripIsExact) {

@@ -3,8 +3,10 @@
 // Passes per frame: (1) a depth-only shadow map of the paper seen from the key
 // light (the first light with shadow == true); (2) ground and paper into a 4x
 // multisampled framebuffer, two-sided Lambert shading with PCF shadows, sRGB
-// encoded in the shader; (3) resolve, read back, flip to top-down rows and turn
-// the coverage-weighted colours into straight alpha.
+// encoded in the shader; (2b) when a structure overlay is given, its lines
+// (depth-tested) and points (on top) as flat screen-space triangles into the
+// same framebuffer; (3) resolve, read back, flip to top-down rows and turn the
+// coverage-weighted colours into straight alpha.
 //
 // Link OSMesa only: with libGL linked too every GL call is a no-op.
 #define GL_GLEXT_PROTOTYPES 1
@@ -27,6 +29,8 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+
+#include "structure_overlay.hpp"
 
 namespace crumple::render {
 
@@ -69,14 +73,19 @@ void main() {
 )";
 
 // Compiled per variant: NUM_LIGHTS (>= 1), KEY_LIGHT (index of the shadow
-// casting light or -1), KEY_IS_POINT, IS_GROUND. llvmpipe executes both sides
-// of a branch under a mask, so everything not needed is compiled out.
+// casting light or -1), KEY_IS_POINT, IS_GROUND, TRI_COLORS (albedo per
+// triangle from a buffer texture indexed by gl_PrimitiveID, the structure
+// overlay's colours). llvmpipe executes both sides of a branch under a mask,
+// so everything not needed is compiled out.
 const char* const kMainFragment = R"(
 in vec3 v_pos;
 in vec3 v_normal;
 in vec2 v_uv;
 uniform sampler2D u_tex;
 uniform sampler2DShadow u_shadowMap;
+#if TRI_COLORS
+uniform samplerBuffer u_triColors;
+#endif
 uniform vec3 u_frontColor;
 uniform vec3 u_backColor;
 uniform vec3 u_groundColor;
@@ -133,6 +142,8 @@ void main() {
   vec3 n = len > 1e-4 ? (gl_FrontFacing ? v_normal : -v_normal) / len : ng;
 #if IS_GROUND
   vec3 albedo = u_groundColor;
+#elif TRI_COLORS
+  vec3 albedo = texelFetch(u_triColors, gl_PrimitiveID).rgb;
 #else
   vec3 albedo = (gl_FrontFacing ? u_frontColor : u_backColor) * texture(u_tex, v_uv).rgb;
 #endif
@@ -152,6 +163,24 @@ void main() {
   }
   o_color = vec4(encodeSrgb(albedo * light), 1.0);
 }
+)";
+
+// The structure overlay: clip-space positions and sRGB colours computed on the
+// CPU (structure_overlay.cpp), written unchanged.
+const char* const kOverlayVertex = R"(
+layout(location = 0) in vec4 a_clip;
+layout(location = 1) in vec4 a_color;
+flat out vec4 v_color;
+void main() {
+  v_color = a_color;
+  gl_Position = a_clip;
+}
+)";
+
+const char* const kOverlayFragment = R"(
+flat in vec4 v_color;
+out vec4 o_color;
+void main() { o_color = v_color; }
 )";
 
 const char* const kShadowVertex = R"(
@@ -318,8 +347,10 @@ struct OsmesaRenderer::Impl {
   OsmesaContext context;
 
   GLuint shadowProgram = 0;
-  // Main-pass programs by variant (lights, key light, key is point, ground).
-  std::map<std::array<int, 4>, GLuint> mainPrograms;
+  GLuint overlayProgram = 0;
+  // Main-pass programs by variant (lights, key light, key is point, ground,
+  // triangle colours).
+  std::map<std::array<int, 5>, GLuint> mainPrograms;
   int shadowSize = kShadowMapSmall;
   GLuint paperVao = 0, paperVbo = 0, paperEbo = 0;
   GLuint groundVao = 0, groundVbo = 0;
@@ -327,6 +358,8 @@ struct OsmesaRenderer::Impl {
   GLuint resolveFbo = 0, resolveColor = 0;
   GLuint shadowFbo = 0, shadowTex = 0;
   GLuint paperTex = 0;
+  GLuint overlayVao = 0, overlayVbo = 0;
+  GLuint triColorBuffer = 0, triColorTex = 0;
   int samples = 0;
 
   // The texture currently uploaded (to skip re-uploading an unchanged one).
@@ -336,6 +369,7 @@ struct OsmesaRenderer::Impl {
   std::vector<Vertex> vertices;
   std::vector<GLuint> indices;
   std::vector<std::uint8_t> readback;
+  std::vector<GLfloat> triColors;
 
   Impl(int w, int h) : width(w), height(h), osmesaBuffer(static_cast<std::size_t>(w) * h * 4) {
     const Current current(*this);
@@ -367,20 +401,26 @@ struct OsmesaRenderer::Impl {
     Current& operator=(const Current&) = delete;
   };
 
-  void createPrograms() { shadowProgram = linkProgram("", kShadowVertex, kShadowFragment); }
+  void createPrograms() {
+    shadowProgram = linkProgram("", kShadowVertex, kShadowFragment);
+    overlayProgram = linkProgram("", kOverlayVertex, kOverlayFragment);
+  }
 
-  GLuint mainProgram(int numLights, int keyLight, bool keyIsPoint, bool ground) {
-    const std::array<int, 4> variant = {numLights, keyLight, keyIsPoint ? 1 : 0, ground ? 1 : 0};
+  GLuint mainProgram(int numLights, int keyLight, bool keyIsPoint, bool ground, bool triColors) {
+    const std::array<int, 5> variant = {numLights, keyLight, keyIsPoint ? 1 : 0, ground ? 1 : 0,
+                                        triColors ? 1 : 0};
     const auto it = mainPrograms.find(variant);
     if (it != mainPrograms.end()) return it->second;
     const std::string defines = "#define NUM_LIGHTS " + std::to_string(numLights) +
                                 "\n#define KEY_LIGHT " + std::to_string(keyLight) +
                                 "\n#define KEY_IS_POINT " + std::to_string(variant[2]) +
-                                "\n#define IS_GROUND " + std::to_string(variant[3]) + "\n";
+                                "\n#define IS_GROUND " + std::to_string(variant[3]) +
+                                "\n#define TRI_COLORS " + std::to_string(variant[4]) + "\n";
     const GLuint program = linkProgram(defines, kMainVertex, kMainFragment);
     glUseProgram(program);
     glUniform1i(glGetUniformLocation(program, "u_tex"), 0);
     glUniform1i(glGetUniformLocation(program, "u_shadowMap"), 1);
+    if (triColors) glUniform1i(glGetUniformLocation(program, "u_triColors"), 2);
     mainPrograms.emplace(variant, program);
     return program;
   }
@@ -412,9 +452,69 @@ struct OsmesaRenderer::Impl {
     glBindVertexArray(groundVao);
     glBindBuffer(GL_ARRAY_BUFFER, groundVbo);
     setupVertexLayout();
+
+    glGenVertexArrays(1, &overlayVao);
+    glGenBuffers(1, &overlayVbo);
+    glBindVertexArray(overlayVao);
+    glBindBuffer(GL_ARRAY_BUFFER, overlayVbo);
+    const auto stride = static_cast<GLsizei>(sizeof(detail::OverlayVertex));
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, stride,
+                          reinterpret_cast<const void*>(offsetof(detail::OverlayVertex, clip)));
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 4, GL_UNSIGNED_BYTE, GL_TRUE, stride,
+                          reinterpret_cast<const void*>(offsetof(detail::OverlayVertex, color)));
     glBindVertexArray(0);
 
     glGenTextures(1, &paperTex);
+    glGenBuffers(1, &triColorBuffer);
+    glGenTextures(1, &triColorTex);
+  }
+
+  // Per-triangle albedo (linear RGB) as an RGBA32F buffer texture on unit 2.
+  void uploadTriangleColors(const std::vector<Vec3>& colors) {
+    GLint maxTexels = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &maxTexels);
+    if (colors.size() > static_cast<std::size_t>(maxTexels))
+      throw std::invalid_argument(
+          "OsmesaRenderer: overlay has more triangle colours than "
+          "GL_MAX_TEXTURE_BUFFER_SIZE " +
+          std::to_string(maxTexels));
+    triColors.resize(colors.size() * 4);
+    for (std::size_t i = 0; i < colors.size(); ++i) {
+      for (std::size_t k = 0; k < 3; ++k)
+        triColors[i * 4 + k] =
+            static_cast<GLfloat>(std::clamp(colors[i][static_cast<Eigen::Index>(k)], 0.0, 1.0));
+      triColors[i * 4 + 3] = 1.0f;
+    }
+    glBindBuffer(GL_TEXTURE_BUFFER, triColorBuffer);
+    glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(triColors.size() * sizeof(GLfloat)),
+                 triColors.data(), GL_STREAM_DRAW);
+    glBindBuffer(GL_TEXTURE_BUFFER, 0);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_BUFFER, triColorTex);
+    glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, triColorBuffer);
+    glActiveTexture(GL_TEXTURE0);
+  }
+
+  // Lines depth-tested against the paper, the ground and each other, then
+  // points over everything (already sorted far to near).
+  void drawOverlay(const detail::OverlayGeometry& g) {
+    if (g.lines.empty() && g.points.empty()) return;
+    glUseProgram(overlayProgram);
+    glBindVertexArray(overlayVao);
+    glBindBuffer(GL_ARRAY_BUFFER, overlayVbo);
+    auto drawTriangles = [](const std::vector<detail::OverlayVertex>& v) {
+      if (v.empty()) return;
+      glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(v.size() * sizeof(v[0])), v.data(),
+                   GL_STREAM_DRAW);
+      glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(v.size()));
+    };
+    drawTriangles(g.lines);
+    glDisable(GL_DEPTH_TEST);
+    drawTriangles(g.points);
+    glEnable(GL_DEPTH_TEST);
+    glBindVertexArray(0);
   }
 
   void createTargets() {
@@ -488,7 +588,8 @@ struct OsmesaRenderer::Impl {
       uploadedTexture = tex;
   }
 
-  ImageRGBA8 render(const RenderScene& scene, const mesh::SheetMesh& sheet);
+  ImageRGBA8 render(const RenderScene& scene, const mesh::SheetMesh& sheet,
+                    const StructureOverlay* overlay);
 };
 
 namespace {
@@ -547,8 +648,13 @@ const ImageRGBA8& ruledTexture() {
 
 }  // namespace
 
-ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::SheetMesh& sheet) {
+ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::SheetMesh& sheet,
+                                        const StructureOverlay* overlay) {
   validateInput(scene, sheet, width, height);
+  if (overlay != nullptr) {
+    detail::validateOverlay(*overlay, sheet.triangles.size());
+    if (overlay->empty()) overlay = nullptr;  // the same bytes as no overlay
+  }
   const Current current(*this);
 
   // Everything is drawn relative to the paper's bounding-box centre so that the
@@ -719,6 +825,8 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
   glActiveTexture(GL_TEXTURE1);
   glBindTexture(GL_TEXTURE_2D, shadowTex);
   glActiveTexture(GL_TEXTURE0);
+  const bool triColors = overlay != nullptr && !overlay->triangleColors.empty() && hasPaper;
+  if (triColors) uploadTriangleColors(overlay->triangleColors);
 
   Camera cam = scene.camera;
   cam.position -= origin;
@@ -760,7 +868,8 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
   const auto lvp = toGl(lightViewProj);
 
   auto draw = [&](bool ground) {
-    const GLuint program = mainProgram(numLights, keyLight, keyIsPoint, ground);
+    const GLuint program =
+        mainProgram(numLights, keyLight, keyIsPoint, ground, triColors && !ground);
     glUseProgram(program);
     auto loc = [&](const char* name) { return glGetUniformLocation(program, name); };
     auto set3 = [&](const char* name, const Vec3& v) {
@@ -793,6 +902,8 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
   if (scene.ground.enabled) draw(true);
   if (hasPaper) draw(false);
   glBindVertexArray(0);
+  if (overlay != nullptr)
+    drawOverlay(detail::buildOverlayGeometry(*overlay, sheet, cam, viewProj, origin));
 
   // --- resolve and read back ----------------------------------------------------
   glBindFramebuffer(GL_READ_FRAMEBUFFER, msFbo);
@@ -844,8 +955,9 @@ OsmesaRenderer::OsmesaRenderer(int width, int height) {
 
 OsmesaRenderer::~OsmesaRenderer() = default;
 
-ImageRGBA8 OsmesaRenderer::render(const RenderScene& scene, const mesh::SheetMesh& sheet) {
-  return impl_->render(scene, sheet);
+ImageRGBA8 OsmesaRenderer::render(const RenderScene& scene, const mesh::SheetMesh& sheet,
+                                  const StructureOverlay* overlay) {
+  return impl_->render(scene, sheet, overlay);
 }
 
 }  // namespace crumple::render

@@ -220,10 +220,13 @@ ElasticSheet::Impl::Impl(const mesh::SheetMesh& m, const Material& material, con
                                 "-1 < Poisson ratio < 0.5");
   if (!p.gravity.allFinite() || !(p.massDamping >= 0.0) || !(p.stiffnessDamping >= 0.0) ||
       !std::isfinite(p.massDamping) || !std::isfinite(p.stiffnessDamping) ||
-      p.maxNewtonIterations < 1 || !(p.newtonTolerance > 0.0) || p.maxHalvings < 0)
+      p.maxNewtonIterations < 1 || !(p.newtonTolerance > 0.0) || p.maxHalvings < 0 ||
+      !(p.membraneScale > 0.0) || !std::isfinite(p.membraneScale))
     throw std::invalid_argument("ElasticSheet: invalid simulation parameters");
 
   moduli = membraneModuli(material);
+  moduli.lambda *= p.membraneScale;
+  moduli.mu *= p.membraneScale;
   bendingRigidity = material.bendingStiffness();
   vertexCount = m.vertexCount();
   triangles = m.triangles;

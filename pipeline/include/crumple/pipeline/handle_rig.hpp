@@ -2,6 +2,7 @@
 // Handles: each binds an animated node to a vertex of the sheet, optionally
 // with tangent-plane control where the node's rotation drives 2-4 neighbour
 // vertices (paper Sec. 4, thesis 2.3.1).
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,8 @@ struct BoundHandle {
   Quat bindRotation = Quat::Identity();
   double releaseTime = 0.0;
   bool releases = false;
+  int tangentCount =
+      -1;  // requested tangent-plane vertex count (0 = automatic), -1 = no tangent control
 };
 
 class HandleRig {
@@ -44,6 +47,11 @@ class HandleRig {
   Vec3 target(std::size_t handle, double t) const;
   // Every pinned vertex and where it must be at time t.
   void pins(double t, std::vector<sim::Pin>& out) const;
+  // The hybrid model rebuilds its simulation mesh S_P as the sheet crumples:
+  // handle vertices keep their indices, tangent-plane vertices are chosen
+  // again on the new mesh, their offsets taken from the flat placement
+  // `rest` (pattern -> world at bind time) the handles were bound in.
+  void rebindTangents(const mesh::SheetMesh& sheet, const std::function<Vec3(const Vec2&)>& rest);
   // Moves pinned vertices onto their targets (called once before simulation).
   void snap(double t, std::vector<Vec3>& positions) const;
 

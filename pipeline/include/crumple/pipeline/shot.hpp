@@ -29,6 +29,7 @@ struct ShotOptions {
                                       // render only this range
   std::optional<std::uint64_t> seed;  // overrides the scene's seed
   bool render = true;                 // `run` renders, `simulate` does not
+  bool debugStructure = false;        // render the crumpling model's structure view
   std::FILE* log = stderr;            // progress and notes
   int interactive = -1;               // -1: detect a terminal on `log`
 };
@@ -54,6 +55,14 @@ struct ShotReport {
   std::size_t triangles = 0;
   double maxHandleError = 0.0;
   double maxStrain = 0.0;
+  // Crumpling model (paper Table IV measures over the frames).
+  bool hybrid = false;
+  double meanCMean = 0.0;  // mean over frames of c_mean
+  double maxCMean = 0.0;
+  double maxNComp = 0.0;
+  int singularVertices = 0;          // at the last frame
+  int interiorSingularVertices = 0;  // at the last frame
+  std::size_t maxTriangles = 0;
   std::map<std::string, StageCost> stages;  // "elastic", "cache", "render"
   std::vector<std::string> warnings;
   std::string error;  // set when the run stopped early (cache valid up to the last frame)
@@ -74,6 +83,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options);
 struct RenderOptions {
   std::optional<FrameRange> frames;  // default: all cached frames
   std::string framesDir;             // default: <cache folder>/frames
+  bool debugStructure = false;  // flat/curved regions, rulings, singular, junction, handle vertices
   std::FILE* log = stderr;
   int interactive = -1;
 };

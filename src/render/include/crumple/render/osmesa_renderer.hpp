@@ -1,7 +1,9 @@
 #pragma once
 // The OSMesa preview rasteriser: the scene camera, a key light with a shadow
 // map, fill lights, the two-sided paper with its pattern texture, a ground
-// plane. Deterministic: identical input gives identical bytes.
+// plane, and optionally a structure overlay (flat/curved region colours,
+// rulings, singular/junction/handle points). Deterministic: identical input
+// gives identical bytes.
 //
 // Output (ImageRGBA8): rows top to bottom, sRGB-encoded colour, straight
 // alpha. Alpha is coverage by paper or ground: 255 where covered, 0 for the
@@ -46,11 +48,16 @@ class OsmesaRenderer {
   OsmesaRenderer(const OsmesaRenderer&) = delete;
   OsmesaRenderer& operator=(const OsmesaRenderer&) = delete;
 
-  // Draws the sheet (positions, triangles, pattern as texture coordinates).
-  // The camera's width/height must match the renderer's. Throws
-  // std::invalid_argument on inconsistent or non-finite input and
-  // std::runtime_error on a GL failure.
-  ImageRGBA8 render(const RenderScene& scene, const mesh::SheetMesh& sheet);
+  // Draws the sheet (positions, triangles, pattern as texture coordinates)
+  // and, when `overlay` is given, the structure view over it (see
+  // StructureOverlay in view.hpp); a null or empty overlay gives the same
+  // bytes as none. The camera's width/height must match the renderer's.
+  // Throws std::invalid_argument on inconsistent or non-finite input
+  // (including an overlay whose triangleColors is neither empty nor one per
+  // triangle, or whose sizes are not positive) and std::runtime_error on a GL
+  // failure.
+  ImageRGBA8 render(const RenderScene& scene, const mesh::SheetMesh& sheet,
+                    const StructureOverlay* overlay = nullptr);
 
  private:
   struct Impl;

@@ -53,6 +53,59 @@ struct PaperLook {
   Vec2 textureSize{0.21, 0.297};  // m covered by the texture in u and v
 };
 
+// A diagnostic overlay drawn over the sheet: the structure view of the hybrid
+// crumpling model (paper Fig. 2: flat regions green, curved regions magenta
+// with their rulings, singular vertices red, junction vertices yellow, handles
+// black). The renderer knows nothing of the model: the caller colours the
+// triangles and lists the lines and points (StructurePalette has the figure's
+// colours).
+//
+// - Triangles keep their lit, two-sided Lambert shading (and shadows) so the
+//   3D shape stays readable; triangleColors only replaces the albedo.
+// - Lines are flat (unlit) screen-space quads lineWidthPx wide with square
+//   caps (half a width beyond each end), depth-tested against the paper and
+//   the ground after a small shift towards the camera (1 + 1.5 * lineWidthPx
+//   pixels of depth), so lines on the surface stay fully visible on faces up
+//   to ~70 degrees from facing the camera while lines behind the paper stay
+//   hidden. A line is straight in 3D: draw a curve as a polyline.
+// - Points are flat discs pointSizePx across with a black rim (a pixel wide,
+//   for points of 4 px and more) so that yellow reads on white paper. A point
+//   is drawn whole, over everything, when the ray from the camera to it meets
+//   no paper triangle nearer than two pixels of depth; otherwise not at all.
+//   Nearer points are drawn over farther ones.
+// All colours are linear RGB (clamped to [0, 1]); sizes are pixels at the
+// render resolution.
+struct StructureOverlay {
+  // Per sheet triangle: replaces the paper texture and front/back colours when
+  // non-empty (size must equal the triangle count).
+  std::vector<Vec3> triangleColors;
+  struct Line {
+    Vec3 a, b;
+    Vec3 color;
+  };
+  std::vector<Line> lines;  // e.g. rulings, region borders
+  struct Point {
+    Vec3 p;
+    Vec3 color;
+  };
+  std::vector<Point> points;  // e.g. singular, junction and handle vertices
+  double lineWidthPx = 2.0;
+  double pointSizePx = 8.0;
+
+  bool empty() const { return triangleColors.empty() && lines.empty() && points.empty(); }
+};
+
+// The colours of the paper's Fig. 2 (linear RGB) for a StructureOverlay.
+struct StructurePalette {
+  Vec3 flat{0.10, 0.50, 0.12};    // flat-region triangles (green)
+  Vec3 curved{0.60, 0.10, 0.55};  // curved-region triangles (magenta)
+  Vec3 ruling{0.22, 0.0, 0.20};   // rulings (darker magenta)
+  Vec3 border{0.02, 0.02, 0.02};  // region borders
+  Vec3 singular{0.90, 0.0, 0.0};  // singular vertices (red)
+  Vec3 junction{1.0, 0.80, 0.0};  // junction vertices (yellow)
+  Vec3 handle{0.0, 0.0, 0.0};     // handles (black)
+};
+
 struct RenderScene {
   Camera camera;
   std::vector<Light> lights;

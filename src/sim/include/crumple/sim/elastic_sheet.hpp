@@ -24,6 +24,11 @@ struct SimParams {
   // newtonTolerance * (typical edge length) -- see docs/ARCHITECTURE.md.
   double newtonTolerance = 1e-7;
   int maxHalvings = 8;  // a failed substep is split in two at most this deep
+  // Multiplies the membrane (stretch) moduli. 1 = the paper's real in-plane
+  // stiffness. The hybrid crumpling model lowers it: its coarse FEM "only
+  // needs stiffness of medium range" since lengths are restored geometrically
+  // (paper Sec. 1 and Sec. 6.3).
+  double membraneScale = 1.0;
 };
 
 // A hard constraint: vertex `vertex` sits at `position`.

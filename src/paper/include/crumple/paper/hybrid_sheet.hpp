@@ -1,0 +1,81 @@
+#pragma once
+// The hybrid crumpling model, one animation step at a time (paper Sec. 3.3,
+// Figs. 3 and 16; thesis Algorithm 1): an elastic step on S_P, positions to
+// S_G, the geometric step (flips, flat-region splits, compression analysis,
+// ruling propagation and singular vertices, junction points, generalized
+// cones), S_P rebuilt from S_G with fiber damage, and the isometry
+// projection of S_P with the handles fixed.
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "crumple/paper/enrich.hpp"
+#include "crumple/paper/geometric_mesh.hpp"
+#include "crumple/paper/geometric_step.hpp"
+#include "crumple/paper/isometry.hpp"
+#include "crumple/paper/params.hpp"
+#include "crumple/sim/elastic_sheet.hpp"
+
+namespace crumple::paper {
+
+// Milliseconds spent in each stage of one step.
+struct HybridStageTimes {
+  double elastic = 0.0;    // FEM on S_P (all substeps)
+  double geometric = 0.0;  // flips, splits, compression, rulings, singular vertices, junctions
+  double cones = 0.0;      // generalized-cone fitting (paper Sec. 6.2)
+  double rebuild = 0.0;    // S_P from S_G, fiber damage, elastic-model setup
+  double isometry = 0.0;   // paper Sec. 6.3
+};
+
+struct HybridStepStats {
+  sim::StepStats elastic;
+  GeometricStepStats geometric;
+  IsometryStats isometry;
+  HybridStageTimes ms;
+  int coneSegments = 0;
+  bool topologyChanged = false;  // S_P was rebuilt with a new connectivity
+};
+
+class HybridSheet {
+ public:
+  // `sg`: the starting S_G (e.g. makeFlatSheet); its handle vertices are the
+  // ones pins refer to, and they keep their indices for the whole run (S_G
+  // vertices before them are corners, which are never removed). `seed`
+  // seeds the singular-vertex placement (CounterRng per frame).
+  HybridSheet(GeometricMesh sg, const sim::Material& material, const sim::SimParams& simParams,
+              const CrumpleParams& params, std::uint64_t seed);
+  ~HybridSheet();
+  HybridSheet(HybridSheet&&) noexcept;
+  HybridSheet& operator=(HybridSheet&&) noexcept;
+
+  // One animation step from t to t + dt for frame `frame`: `substeps`
+  // elastic steps of dt / substeps, then the geometric step, cone fitting,
+  // S_P rebuild and isometry. Pins refer to S_G vertex indices. Throws
+  // NumericalError naming the frame and stage on failure, leaving the sheet
+  // as it was before the call.
+  HybridStepStats advance(double t, double dt, int substeps, const sim::PinFunction& pins,
+                          int frame);
+
+  // Called with the new S_P every time it is rebuilt, before the isometry
+  // step asks for pins again (the handle rig re-chooses its tangent-plane
+  // vertices there).
+  void setRebuildCallback(std::function<void(const mesh::SheetMesh&)> callback);
+
+  // Moves pinned vertices (S_G or S_P indices) to the given positions before
+  // the first step (handles snapping onto their tracks) and re-interpolates
+  // S_P from S_G.
+  void placeVertices(const std::vector<sim::Pin>& pins);
+
+  const GeometricMesh& geometric() const;  // S_G
+  const PhysicalMesh& physical() const;    // S_P (the displayed mesh)
+  const CrumpleParams& params() const;
+  int singularVertexCount() const;
+  int interiorSingularVertexCount() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace crumple::paper

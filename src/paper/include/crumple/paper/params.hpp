@@ -1,0 +1,46 @@
+#pragma once
+// User parameters of the hybrid crumpling model (paper Table VI; thesis
+// 2.3.3, 2.4.1). Lengths are in metres, angles in radians.
+#include <numbers>
+#include <string>
+
+namespace crumple::paper {
+
+struct CrumpleParams {
+  // Boundary sampling density of S_P and of curved-region rulings (paper
+  // Table VI: 1.2 samples/cm), in samples per metre.
+  double rhoBound = 120.0;
+  // Interior sampling density of flat regions in S_P, samples per m^2.
+  // Table VI prints "6 samples/cm^2", which would put ~600 interior vertices
+  // on the 10 cm validation sheet, while Table V's meshes average 87-156
+  // triangles. We read the 6 as samples per row across L_paper = 10 cm,
+  // i.e. an isotropic spacing of 10/6 cm and (6/10 cm)^2 = 0.36 /cm^2: a flat
+  // 10 cm sheet then has 48 boundary and ~25-36 interior samples, ~118
+  // triangles (Table V, Fig. 1). See docs/CRUMPLING.md "S_P size".
+  double rhoInt = 3600.0;
+  double theta0 = 0.01;                       // coplanarity threshold (rad)
+  double thetaLow = 0.001;                    // junction hysteresis, theta0 / 10
+  double thetaHigh = 0.01;                    // junction hysteresis, theta0
+  double epsBlaschke = 0.005;                 // cone-fit tolerance as a fraction of L_paper
+  double epsC = 0.001;                        // compression threshold (0.1 %)
+  double sigma = 0.001;                       // singular-vertex position spread (0.1 cm)
+  double thetaRest = std::numbers::pi / 8.0;  // fiber damage rest angle (thesis eq. 2.1)
+  double damage = 10.0;                       // fiber damage D (thesis eq. 2.2)
+  int isometryIterations = 200;               // Phase I iteration cap (paper Sec. 6.3)
+  // Membrane stiffness of the coarse FEM on S_P as a fraction of the paper's
+  // (sim::SimParams::membraneScale): "stiffness only needs to be of medium
+  // range" (paper Sec. 1), lengths are restored by the isometry step.
+  double membraneScale = 0.01;
+  // Steps a region waits after it was cut before its compression is treated
+  // again: cutting a compressed region leaves equally compressed pieces
+  // until the elastic steps have bent S_P along the new structure (Appendix
+  // B: "let the physical simulation further deform this region").
+  int remeshCooldown = 3;
+#ifdef NDEBUG
+  bool checkInvariants = false;  // validate S_G and S_P after every geometric step
+#else
+  bool checkInvariants = true;
+#endif
+};
+
+}  // namespace crumple::paper

@@ -1,0 +1,369 @@
+#include "crumple/paper/hybrid_sheet.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <deque>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include "crumple/core/error.hpp"
+#include "crumple/paper/boundary_curve.hpp"
+#include "crumple/paper/cone_fit.hpp"
+#include "crumple/paper/damage.hpp"
+
+namespace crumple::paper {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+bool allFinite(const std::vector<Vec3>& v) {
+  return std::all_of(v.begin(), v.end(), [](const Vec3& x) { return x.allFinite(); });
+}
+
+}  // namespace
+
+struct HybridSheet::Impl {
+  GeometricMesh sg;
+  PhysicalMesh sp;
+  sim::Material material;
+  sim::SimParams simParams;
+  CrumpleParams params;
+  std::uint64_t seed = 1;
+  std::optional<sim::ElasticSheet> elastic;
+  std::optional<IsometryProjector> isometry;
+  std::vector<Vec3> spVelocities;
+  double paperLength = 0.0;
+  std::function<void(const mesh::SheetMesh&)> onRebuild;
+  // Faces (by the pattern positions of their vertices) at the end of each of
+  // the last remeshCooldown steps, oldest first.
+  std::deque<std::set<std::vector<std::int64_t>>> faceHistory;
+
+  std::vector<std::int64_t> faceKey(const GeometricFace& f) const {
+    std::vector<std::array<std::int64_t, 2>> corners;
+    for (int k = 0; k < f.size(); ++k) {
+      const Vec2& p = sg.vertices[static_cast<std::size_t>(f.v[k])].pattern;
+      corners.push_back({std::llround(p.x() * 1e9), std::llround(p.y() * 1e9)});
+    }
+    std::sort(corners.begin(), corners.end());
+    std::vector<std::int64_t> key;
+    for (const auto& c : corners) key.insert(key.end(), c.begin(), c.end());
+    return key;
+  }
+  void rememberFaces() {
+    std::set<std::vector<std::int64_t>> keys;
+    for (const GeometricFace& f : sg.faces) keys.insert(faceKey(f));
+    faceHistory.push_back(std::move(keys));
+    while (faceHistory.size() > static_cast<std::size_t>(std::max(params.remeshCooldown, 1)))
+      faceHistory.pop_front();
+  }
+
+  // S_P from S_G (paper Sec. 4, Fig. 16 (g)) with fiber damage (thesis 2.3.3).
+  // Returns true when the connectivity or pattern changed.
+  bool rebuildPhysical() {
+    PhysicalMesh next = buildPhysicalMesh(sg, params);
+    updateSamples(next, sg, &spVelocities);
+    const bool same = elastic.has_value() && next.mesh.triangles == sp.mesh.triangles &&
+                      next.mesh.pattern == sp.mesh.pattern;
+    sp = std::move(next);
+    if (!same) {
+      elastic.emplace(sp.mesh, material, simParams);
+    } else {
+      elastic->setPositions(sp.mesh.positions);
+    }
+    elastic->setVelocities(spVelocities);
+    // Damage: rest angles and weakened bending around singular vertices.
+    std::vector<char> singular(sp.mesh.vertexCount(), 0);
+    for (std::size_t v = 0; v < sg.vertices.size(); ++v)
+      singular[v] = sg.vertices[v].singular ? 1 : 0;
+    const auto& hinges = elastic->hinges();
+    std::vector<double> angles(hinges.size());
+    for (std::size_t h = 0; h < hinges.size(); ++h) angles[h] = elastic->hingeAngle(h);
+    const auto damage = fiberDamage(sp.mesh, hinges, singular, angles, params);
+    for (std::size_t h = 0; h < hinges.size(); ++h) {
+      elastic->setHingeRestAngle(h, damage[h].restAngle);
+      elastic->setHingeStiffnessFactor(h, damage[h].stiffnessFactor);
+    }
+    if (onRebuild) onRebuild(sp.mesh);
+    return !same;
+  }
+
+  void checkInvariants(int frame, const char* stage) const {
+    const std::string problem = validate(sg, params.theta0);
+    if (!problem.empty()) throw NumericalError(stage, frame, "S_G invariant broken: " + problem);
+    if (sp.geometricVertexCount() != sg.vertexCount()) {
+      throw NumericalError(stage, frame, "S_P does not hold every S_G vertex");
+    }
+    const std::string mp = mesh::validate(sp.mesh);
+    if (!mp.empty()) throw NumericalError(stage, frame, "S_P invalid: " + mp);
+    double area = 0.0;
+    for (const auto& t : sp.mesh.triangles) {
+      const Vec2 a = sp.mesh.pattern[static_cast<std::size_t>(t[1])] -
+                     sp.mesh.pattern[static_cast<std::size_t>(t[0])];
+      const Vec2 b = sp.mesh.pattern[static_cast<std::size_t>(t[2])] -
+                     sp.mesh.pattern[static_cast<std::size_t>(t[0])];
+      area += 0.5 * (a.x() * b.y() - a.y() * b.x());
+    }
+    const double sheet = outlineArea(sg);
+    if (std::abs(area - sheet) > 1e-9 * sheet) {
+      std::ostringstream msg;
+      msg << "S_P covers " << area << " m^2 of the " << sheet << " m^2 sheet";
+      throw NumericalError(stage, frame, msg.str());
+    }
+  }
+};
+
+HybridSheet::HybridSheet(GeometricMesh sg, const sim::Material& material,
+                         const sim::SimParams& simParams, const CrumpleParams& params,
+                         std::uint64_t seed)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.sg = std::move(sg);
+  m.material = material;
+  m.simParams = simParams;
+  m.simParams.membraneScale = params.membraneScale;
+  if (const char* e = std::getenv("CRUMPLE_EXP_TOL")) m.simParams.newtonTolerance = std::atof(e);
+  if (const char* e = std::getenv("CRUMPLE_EXP_IT")) m.simParams.maxNewtonIterations = std::atoi(e);
+  if (const char* e = std::getenv("CRUMPLE_EXP_MS")) m.simParams.membraneScale = std::atof(e);
+  m.params = params;
+  m.seed = seed;
+  for (const Vec2& a : m.sg.outline) {
+    for (const Vec2& b : m.sg.outline) m.paperLength = std::max(m.paperLength, (a - b).norm());
+  }
+  const std::string problem = validate(m.sg);
+  if (!problem.empty()) throw std::invalid_argument("HybridSheet: invalid S_G: " + problem);
+  m.rebuildPhysical();
+}
+
+HybridSheet::~HybridSheet() = default;
+HybridSheet::HybridSheet(HybridSheet&&) noexcept = default;
+HybridSheet& HybridSheet::operator=(HybridSheet&&) noexcept = default;
+
+void HybridSheet::setRebuildCallback(std::function<void(const mesh::SheetMesh&)> callback) {
+  impl_->onRebuild = std::move(callback);
+  if (impl_->onRebuild) impl_->onRebuild(impl_->sp.mesh);
+}
+
+void HybridSheet::placeVertices(const std::vector<sim::Pin>& pins) {
+  Impl& m = *impl_;
+  for (const sim::Pin& p : pins) {
+    if (static_cast<std::size_t>(p.vertex) < m.sg.vertices.size()) {
+      m.sg.vertices[static_cast<std::size_t>(p.vertex)].position = p.position;
+    }
+  }
+  updateSamples(m.sp, m.sg);
+  for (const sim::Pin& p : pins)
+    m.sp.mesh.positions[static_cast<std::size_t>(p.vertex)] = p.position;
+  m.elastic->setPositions(m.sp.mesh.positions);
+}
+
+const GeometricMesh& HybridSheet::geometric() const { return impl_->sg; }
+const PhysicalMesh& HybridSheet::physical() const { return impl_->sp; }
+const CrumpleParams& HybridSheet::params() const { return impl_->params; }
+
+int HybridSheet::singularVertexCount() const {
+  return static_cast<int>(std::count_if(impl_->sg.vertices.begin(), impl_->sg.vertices.end(),
+                                        [](const GeometricVertex& v) { return v.singular; }));
+}
+
+int HybridSheet::interiorSingularVertexCount() const {
+  return static_cast<int>(
+      std::count_if(impl_->sg.vertices.begin(), impl_->sg.vertices.end(),
+                    [](const GeometricVertex& v) { return v.singular && !v.onBoundary; }));
+}
+
+HybridStepStats HybridSheet::advance(double t, double dt, int substeps,
+                                     const sim::PinFunction& pins, int frame) {
+  Impl& m = *impl_;
+  HybridStepStats stats;
+  // The state before the step, restored when a stage fails.
+  const GeometricMesh sgBefore = m.sg;
+  const std::vector<Vec3> xBefore = m.elastic->positions();
+  const std::vector<Vec3> vBefore = m.elastic->velocities();
+  const char* stage = "elastic";
+  try {
+    // (a)-(b) elastic relaxation of S_P with the handles as hard constraints.
+    auto t0 = Clock::now();
+    const int n = std::max(1, substeps);
+    for (int k = 0; k < n; ++k) {
+      const sim::StepStats s = m.elastic->advance(t + dt * k / n, dt / n, pins);
+      stats.elastic.newtonIterations += s.newtonIterations;
+      stats.elastic.halvings += s.halvings;
+      stats.elastic.solves += s.solves;
+      stats.elastic.finalStepNorm = s.finalStepNorm;
+    }
+    stats.ms.elastic = msSince(t0);
+    const std::vector<Vec3>& x = m.elastic->positions();
+    const std::vector<Vec3>& v = m.elastic->velocities();
+    // (c) S_P -> S_G.
+    for (std::size_t i = 0; i < m.sg.vertices.size(); ++i) {
+      m.sg.vertices[i].position = x[i];
+      m.sg.vertices[i].velocity = v[i];
+    }
+    // (d)-(e) geometric step (thesis Algorithm 1).
+    stage = "geometric";
+    t0 = Clock::now();
+    const BoundaryCurve curve =
+        boundaryCurveFromMesh(m.sg, m.sp.mesh.pattern, x, 1e-9 * m.paperLength);
+    const BoundaryPosition boundary = [&curve](double s) { return curve.evaluate(s); };
+    // With invariant checks on, every sub-step is checked so a failure names it.
+    const auto checkAfter = [&](const char* step) {
+      if (!m.params.checkInvariants) return;
+      if (const std::string problem = validate(m.sg); !problem.empty()) {
+        throw NumericalError("geometric", frame,
+                             std::string("S_G invariant broken after ") + step + ": " + problem);
+      }
+    };
+    updateJunctions(m.sg, m.params, boundary, stats.geometric);
+    checkAfter("junction update");
+    stats.geometric.edgeFlips = flipCompressedEdges(m.sg, m.params);
+    checkAfter("edge flips");
+    bendFoldedFlatRegions(m.sg, m.params, boundary, stats.geometric);
+    checkAfter("folded flat regions");
+    stats.geometric.flatSplits = splitFlatRegions(m.sg, m.params);
+    checkAfter("flat-region splits");
+    const CounterRng rng(m.seed, frame, RngPurpose::SingularityPlacement);
+    std::uint64_t draw = 0;
+    // A face may be remeshed once it has existed for remeshCooldown steps.
+    const FaceFilter settled = [&m](int face) {
+      if (m.params.remeshCooldown <= 0) return true;
+      if (m.faceHistory.size() < static_cast<std::size_t>(m.params.remeshCooldown))
+        return true;  // start
+      return m.faceHistory.front().contains(m.faceKey(m.sg.faces[static_cast<std::size_t>(face)]));
+    };
+    treatCompression(m.sg, m.params, boundary, rng, draw, stats.geometric, settled);
+    checkAfter("compression treatment");
+    treatCurvedCompression(m.sg, m.params, rng, draw, stats.geometric, settled);
+    checkAfter("curved-region compression");
+    stats.ms.geometric = msSince(t0);
+    // (f) generalized cones (paper Sec. 6.2).
+    stage = "cones";
+    t0 = Clock::now();
+    for (std::size_t r = 0; r < m.sg.regions.size(); ++r) {
+      const Region& region = m.sg.regions[r];
+      if (region.type != mesh::RegionType::Curved || region.apex >= 0 || region.rulings.size() < 3)
+        continue;
+      const GeometricMesh before = m.sg;
+      const ConeRefitResult fit =
+          refitCurvedRegion(m.sg, static_cast<int>(r), curve, m.params, m.paperLength);
+      GeometricMesh compacted = m.sg;  // the fit leaves unused vertices for compact()
+      compact(compacted);
+      if (const std::string problem = validate(compacted); !problem.empty()) {
+        m.sg = before;  // transactional, like the other remeshing steps
+        stats.geometric.notes.push_back("cone fit of curved region " + std::to_string(r) +
+                                        " undone (" + problem + ")");
+        continue;
+      }
+      stats.coneSegments += fit.segmentCount;
+    }
+    compact(m.sg);
+    // Faces created by the remeshing are flat only when coplanar: regions are
+    // the maximal coplanar sets again before S_P is built.
+    splitFlatRegions(m.sg, m.params);
+    stats.ms.cones = msSince(t0);
+    for (const GeometricVertex& gv : m.sg.vertices) {
+      if (!gv.position.allFinite())
+        throw NumericalError("geometric", frame, "S_G vertex position is not finite");
+    }
+    if (m.params.checkInvariants) {
+      const std::string problem = validate(m.sg, m.params.theta0);
+      if (!problem.empty())
+        throw NumericalError("geometric", frame, "S_G invariant broken: " + problem);
+    }
+    // (g) S_P from S_G.
+    stage = "rebuild";
+    t0 = Clock::now();
+    stats.topologyChanged = m.rebuildPhysical();
+    stats.ms.rebuild = msSince(t0);
+    if (m.params.checkInvariants) m.checkInvariants(frame, "geometric");
+    // (h) isometry with the handles fixed (paper Sec. 6.3).
+    stage = "isometry";
+    t0 = Clock::now();
+    std::vector<sim::Pin> pinned;
+    pins(t + dt, pinned);
+    std::vector<int> fixed;
+    for (const sim::Pin& p : pinned) fixed.push_back(p.vertex);
+    std::sort(fixed.begin(), fixed.end());
+    fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
+    if (!m.isometry || !m.isometry->sameTopology(m.sp.mesh.triangles, fixed) ||
+        static_cast<std::size_t>(m.isometry->vertexCount()) != m.sp.mesh.vertexCount() ||
+        stats.topologyChanged) {
+      m.isometry.emplace(m.sp.mesh.pattern, m.sp.mesh.triangles, fixed);
+    }
+    std::vector<Vec3> positions = m.sp.mesh.positions;
+    stats.isometry = m.isometry->project(positions, m.params.isometryIterations);
+    if (!allFinite(positions)) throw NumericalError("isometry", frame, "non-finite positions");
+    if (stats.isometry.meanLengthErrorAfter > stats.isometry.meanLengthErrorBefore) {
+      // Never let the projection make lengths worse (it has no convergence
+      // guarantee, paper Sec. 6.3): keep the unprojected S_P then.
+      positions = m.sp.mesh.positions;
+      stats.isometry.meanLengthErrorAfter = stats.isometry.meanLengthErrorBefore;
+      stats.isometry.meanDisplacement = 0.0;
+    }
+    m.sp.mesh.positions = positions;
+    for (std::size_t i = 0; i < m.sg.vertices.size(); ++i) m.sg.vertices[i].position = positions[i];
+    m.elastic->setPositions(positions);
+    m.rememberFaces();
+    stats.ms.isometry = msSince(t0);
+    if (const char* env = std::getenv("CRUMPLE_DEBUG_GEOMETRY"); env != nullptr && env[0] == '1') {
+      // Developer trace of the geometric step, one line per frame.
+      int curved = 0;
+      for (const Region& r : m.sg.regions) curved += r.type == mesh::RegionType::Curved ? 1 : 0;
+      const GeometricStepStats& gs = stats.geometric;
+      std::fprintf(stderr,
+                   "[geometry] frame %d: S_G %zu v %zu f %zu regions (%d curved), S_P %zu tris; "
+                   "flips %d splits %d "
+                   "curved+ %d singular+ %d creases %d junction %d flattened %d cmax %.4f; c_mean "
+                   "%.2e -> %.2e\n",
+                   frame, m.sg.vertices.size(), m.sg.faces.size(), m.sg.regions.size(), curved,
+                   m.sp.mesh.triangleCount(), gs.edgeFlips, gs.flatSplits, gs.curvedCreated,
+                   gs.singularInserted, gs.creases, gs.junctionMoves, gs.curvedFlattened,
+                   gs.maxCompression, stats.isometry.meanLengthErrorBefore,
+                   stats.isometry.meanLengthErrorAfter);
+      for (const std::string& note : gs.notes)
+        std::fprintf(stderr, "[geometry]   %s\n", note.c_str());
+    }
+  } catch (const std::exception& e) {
+    if (const char* dump = std::getenv("CRUMPLE_DEBUG_DUMP"); dump != nullptr) {
+      // Developer aid: the S_P that failed, as OBJ (pattern as vt).
+      std::FILE* f = std::fopen(dump, "w");
+      if (f != nullptr) {
+        const auto& mm = m.sp.mesh;
+        std::vector<int> uses(mm.vertexCount(), 0);
+        for (const auto& t : mm.triangles)
+          for (int k : t) ++uses[static_cast<std::size_t>(k)];
+        for (std::size_t i = 0; i < mm.vertexCount(); ++i)
+          std::fprintf(f, "v %.9g %.9g %.9g\n# uses %d pattern %.9g %.9g sg %d\n",
+                       mm.positions[i].x(), mm.positions[i].y(), mm.positions[i].z(), uses[i],
+                       mm.pattern[i].x(), mm.pattern[i].y(), i < m.sg.vertices.size() ? 1 : 0);
+        for (const auto& t : mm.triangles)
+          std::fprintf(f, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);
+        std::fclose(f);
+      }
+    }
+    m.sg = sgBefore;
+    m.elastic.reset();
+    m.isometry.reset();
+    m.rebuildPhysical();
+    m.elastic->setPositions(xBefore);
+    m.elastic->setVelocities(vBefore);
+    m.sp.mesh.positions = xBefore;
+    m.spVelocities = vBefore;
+    if (const auto* numerical = dynamic_cast<const NumericalError*>(&e)) {
+      if (numerical->frame() >= 0) throw;
+      throw NumericalError(numerical->stage(), frame, numerical->problem());
+    }
+    throw NumericalError(stage, frame, e.what());
+  }
+  return stats;
+}
+
+}  // namespace crumple::paper

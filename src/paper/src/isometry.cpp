@@ -1,0 +1,404 @@
+// Isometry projection (paper Sec. 6.3, eqs. (3)-(7)). See isometry.hpp for the
+// scheme and for every deviation from the paper.
+#include "crumple/paper/isometry.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "crumple/core/error.hpp"
+
+namespace crumple::paper {
+
+namespace {
+
+constexpr const char* kStage = "isometry";
+
+bool finite(const Vec3& v) { return v.allFinite(); }
+
+}  // namespace
+
+struct IsometryProjector::Impl {
+  int n = 0;
+  std::vector<Vec2> pattern;
+  std::vector<std::array<int, 3>> triangles;
+  std::vector<int> fixed;                       // sorted, unique
+  std::vector<std::array<int, 2>> edges;        // (i, j), i < j, sorted
+  std::vector<double> restLength;               // lbar_e (m)
+  double lengthScale = 1.0;                     // mean lbar_e: Phase I works in lbar / lengthScale
+  std::vector<std::array<int, 3>> triEdges;     // edges ab, bc, ca of each triangle
+  std::vector<std::array<double, 3>> triSigns;  // +1 when the triangle walks the edge i -> j
+
+  // Phase II (eq. (7)): graph Laplacian restricted to the free vertices.
+  std::vector<int> freeIndex;  // -1 for a pinned vertex (fixed or component anchor)
+  std::vector<std::vector<int>> floatingComponents;  // components without a fixed vertex
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> factor;
+  int freeCount = 0;
+
+  IsometryOptions options;
+
+  void build();
+  int phaseOne(const std::vector<Vec3>& u0, std::vector<Vec3>& u, int maxIterations) const;
+  std::vector<Vec3> phaseTwo(const std::vector<Vec3>& input, const std::vector<Vec3>& u) const;
+};
+
+// Edge list, triangle-edge incidence with orientation signs (eq. (3)), and
+// the Phase II matrix of eq. (7), factored once per topology.
+void IsometryProjector::Impl::build() {
+  n = static_cast<int>(pattern.size());
+  for (const Vec2& p : pattern) {
+    if (!p.allFinite()) throw std::invalid_argument("isometry: non-finite pattern coordinate");
+  }
+  for (const auto& t : triangles) {
+    for (int k = 0; k < 3; ++k) {
+      if (t[k] < 0 || t[k] >= n) throw std::invalid_argument("isometry: vertex index out of range");
+    }
+    if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) {
+      throw std::invalid_argument("isometry: triangle with a repeated vertex");
+    }
+  }
+  if (options.rounds < 1) throw std::invalid_argument("isometry: rounds must be >= 1");
+  if (!(options.tolerance > 0.0)) throw std::invalid_argument("isometry: tolerance must be > 0");
+  std::sort(fixed.begin(), fixed.end());
+  fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
+  for (int v : fixed) {
+    if (v < 0 || v >= n) throw std::invalid_argument("isometry: fixed vertex out of range");
+  }
+
+  // Undirected edges, each oriented from the lower to the higher index.
+  std::vector<std::array<int, 2>> all;
+  all.reserve(3 * triangles.size());
+  for (const auto& t : triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      all.push_back({std::min(a, b), std::max(a, b)});
+    }
+  }
+  std::sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  edges = std::move(all);
+  auto edgeIndex = [&](int a, int b) {
+    const std::array<int, 2> key{std::min(a, b), std::max(a, b)};
+    return static_cast<int>(std::lower_bound(edges.begin(), edges.end(), key) - edges.begin());
+  };
+  restLength.resize(edges.size());
+  double sum = 0.0;
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    restLength[e] = (pattern[edges[e][1]] - pattern[edges[e][0]]).norm();
+    if (!(restLength[e] > 0.0)) {
+      throw std::invalid_argument("isometry: zero-length pattern edge (" +
+                                  std::to_string(edges[e][0]) + ", " + std::to_string(edges[e][1]) +
+                                  ")");
+    }
+    sum += restLength[e];
+  }
+  lengthScale = edges.empty() ? 1.0 : sum / static_cast<double>(edges.size());
+  triEdges.resize(triangles.size());
+  triSigns.resize(triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const int a = triangles[t][k], b = triangles[t][(k + 1) % 3];
+      triEdges[t][k] = edgeIndex(a, b);
+      triSigns[t][k] = a < b ? 1.0 : -1.0;
+    }
+  }
+
+  // Connected components (union-find, deterministic: the root is the lowest index).
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const auto& e : edges) {
+    const int ra = find(e[0]), rb = find(e[1]);
+    if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+  }
+  std::vector<char> anchored(n, 0);
+  for (int v : fixed) anchored[find(v)] = 1;
+  freeIndex.assign(n, 0);
+  for (int v : fixed) freeIndex[v] = -1;
+  std::vector<int> componentSlot(n, -1);
+  for (int v = 0; v < n; ++v) {
+    const int r = find(v);
+    if (anchored[r]) continue;
+    if (r == v) {
+      // The lowest vertex of a component without a fixed vertex is pinned;
+      // Phase II then translates the component back to its input centroid.
+      freeIndex[v] = -1;
+      componentSlot[v] = static_cast<int>(floatingComponents.size());
+      floatingComponents.emplace_back();
+    }
+    floatingComponents[componentSlot[r]].push_back(v);
+  }
+  freeCount = 0;
+  for (int v = 0; v < n; ++v) {
+    if (freeIndex[v] >= 0) freeIndex[v] = freeCount++;
+  }
+
+  // Eq. (7): normal equations are the graph Laplacian on the free vertices.
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(4 * edges.size());
+  for (const auto& e : edges) {
+    const int fa = freeIndex[e[0]], fb = freeIndex[e[1]];
+    if (fa >= 0) trip.emplace_back(fa, fa, 1.0);
+    if (fb >= 0) trip.emplace_back(fb, fb, 1.0);
+    if (fa >= 0 && fb >= 0) {
+      trip.emplace_back(fa, fb, -1.0);
+      trip.emplace_back(fb, fa, -1.0);
+    }
+  }
+  Eigen::SparseMatrix<double> laplacian(freeCount, freeCount);
+  laplacian.setFromTriplets(trip.begin(), trip.end());
+  if (freeCount > 0) {
+    factor.compute(laplacian);
+    if (factor.info() != Eigen::Success) {
+      throw NumericalError(kStage, "Phase II Laplacian factorisation failed");
+    }
+  }
+}
+
+// Paper Sec. 6.3, Phase I, eqs. (3)-(6): iterates the unit edge directions u
+// (in/out, starting at u0) towards C_unit = 0 and C_closed = 0 with two
+// Lagrange multipliers and H = I. Returns the number of iterations taken.
+int IsometryProjector::Impl::phaseOne(const std::vector<Vec3>& u0, std::vector<Vec3>& u,
+                                      int maxIterations) const {
+  const std::size_t m = edges.size(), nt = triangles.size();
+  if (m == 0 || nt == 0) return 0;
+  const bool anchored = options.objective == PhaseOneObjective::Anchored;
+  const double tol = options.tolerance;
+  std::vector<double> lhat(m);  // lbar_e in units of the mean pattern edge
+  for (std::size_t e = 0; e < m; ++e) lhat[e] = restLength[e] / lengthScale;
+  std::vector<Vec3> g1(m), g2(m), gradE(m, Vec3::Zero()), step(m), r(nt);
+  int it = 0;
+  for (; it < maxIterations; ++it) {
+    // C_unit = sum_e (u_e.u_e - 1)^2 (eq. (4)) and its gradient 4 (u.u - 1) u.
+    double c1 = 0.0;
+    for (std::size_t e = 0; e < m; ++e) {
+      const double s = u[e].squaredNorm() - 1.0;
+      c1 += s * s;
+      g1[e] = (4.0 * s) * u[e];
+    }
+    // C_closed = sum_t |lbar_ij u_ij + lbar_jk u_jk + lbar_ki u_ki|^2 (eq. (3)),
+    // each edge entering with the sign of the triangle's walk along it.
+    double c2 = 0.0;
+    for (std::size_t t = 0; t < nt; ++t) {
+      Vec3 rt = Vec3::Zero();
+      for (int k = 0; k < 3; ++k) {
+        const int e = triEdges[t][k];
+        rt += (triSigns[t][k] * lhat[e]) * u[e];
+      }
+      r[t] = rt;
+      c2 += rt.squaredNorm();
+    }
+    for (auto& g : g2) g.setZero();
+    for (std::size_t t = 0; t < nt; ++t) {
+      for (int k = 0; k < 3; ++k) {
+        const int e = triEdges[t][k];
+        g2[e] += (2.0 * triSigns[t][k] * lhat[e]) * r[t];
+      }
+    }
+    const bool met1 = std::sqrt(c1 / static_cast<double>(m)) < tol;
+    const bool met2 = std::sqrt(c2 / static_cast<double>(nt)) < tol;
+    if (met1 && met2) break;  // both constraints satisfied
+
+    // Eq. (5) with H = I reduces to eq. (6):
+    //   L^T L dlambda = L^T b_x - b_lambda,  dx = b_x - L dlambda,
+    // b_x = -grad E - L lambda, b_lambda = -C. Substituting b_x, the old
+    // lambda cancels: L^T L lambda' = C - L^T grad E with lambda' = lambda +
+    // dlambda, and dx = -grad E - L lambda'. We solve for lambda' directly,
+    // which is eq. (6) without the cancellation of the diverging multipliers
+    // the paper warns about. grad E = u - u0 (Anchored, the paper's E) or 0
+    // (Recentred: E measured from the current iterate, see the header).
+    if (anchored) {
+      for (std::size_t e = 0; e < m; ++e) gradE[e] = u[e] - u0[e];
+    }
+    double g11 = 0.0, g12 = 0.0, g22 = 0.0, a1 = 0.0, a2 = 0.0;
+    for (std::size_t e = 0; e < m; ++e) {
+      g11 += g1[e].squaredNorm();
+      g12 += g1[e].dot(g2[e]);
+      g22 += g2[e].squaredNorm();
+      a1 += g1[e].dot(gradE[e]);
+      a2 += g2[e].dot(gradE[e]);
+    }
+    const double rhs1 = c1 - a1, rhs2 = c2 - a2;
+    // Guarded 2x2 solve. A constraint already met (its gradient is then
+    // rounding noise, e.g. C_unit at the unit start vectors u0) or whose
+    // gradient vanishes is dropped, leaving a 1x1 system; otherwise the system
+    // is Jacobi scaled, [1 c; c 1] mu = D rhs with D = diag(1/|grad C_k|), and
+    // parallel gradients (1 - c^2 tiny) take the minimum-norm rank-one solution.
+    constexpr double kNegligibleGradient = 1e-150;  // keeps |grad C|^2 a normal double
+    const double n1 = std::sqrt(g11), n2 = std::sqrt(g22);
+    const bool act1 = !met1 && n1 > kNegligibleGradient;
+    const bool act2 = !met2 && n2 > kNegligibleGradient;
+    if (!act1 && !act2) break;  // nothing left to linearise: stop rather than divide by 0
+    double l1 = 0.0, l2 = 0.0;
+    if (act1 && act2) {
+      const double c = std::clamp(g12 / (n1 * n2), -1.0, 1.0);
+      const double b1 = rhs1 / n1, b2 = rhs2 / n2;
+      const double det = 1.0 - c * c;
+      if (det > 1e-10) {
+        l1 = (b1 - c * b2) / det / n1;
+        l2 = (b2 - c * b1) / det / n2;
+      } else {
+        const double sgn = c >= 0.0 ? 1.0 : -1.0;
+        const double mu = 0.25 * (b1 + sgn * b2);  // [1 s; s 1]^+ b along (1, s)
+        l1 = mu / n1;
+        l2 = sgn * mu / n2;
+      }
+    } else if (act1) {
+      l1 = rhs1 / g11;
+    } else {
+      l2 = rhs2 / g22;
+    }
+    if (!std::isfinite(l1) || !std::isfinite(l2)) break;  // keep the last finite iterate
+    double maxStep = 0.0;
+    for (std::size_t e = 0; e < m; ++e) {
+      step[e] = -gradE[e] - l1 * g1[e] - l2 * g2[e];
+      maxStep = std::max(maxStep, step[e].norm());
+    }
+    if (!std::isfinite(maxStep)) break;
+    // Safety cap (never reached in the tests): no direction moves by more than
+    // kMaxStep per iteration, so a near-null gradient cannot fling u away.
+    constexpr double kMaxStep = 0.5;
+    const double scale = maxStep > kMaxStep ? kMaxStep / maxStep : 1.0;
+    for (std::size_t e = 0; e < m; ++e) u[e] += scale * step[e];
+  }
+  return it;
+}
+
+// Paper Sec. 6.3, Phase II, eq. (7): min 1/2 sum_e |(p_j - p_i) - lbar_e u_e|^2
+// over the free vertices; fixed and anchor vertices keep their `input`
+// positions and move to the right-hand side. x, y, z share the factor.
+std::vector<Vec3> IsometryProjector::Impl::phaseTwo(const std::vector<Vec3>& input,
+                                                    const std::vector<Vec3>& u) const {
+  std::vector<Vec3> out = input;
+  if (freeCount > 0) {
+    Eigen::MatrixX3d rhs = Eigen::MatrixX3d::Zero(freeCount, 3);
+    for (std::size_t e = 0; e < edges.size(); ++e) {
+      const int i = edges[e][0], j = edges[e][1];
+      const Vec3 w = restLength[e] * u[e];
+      const int fi = freeIndex[i], fj = freeIndex[j];
+      if (fj >= 0) rhs.row(fj) += w.transpose();
+      if (fi >= 0) rhs.row(fi) -= w.transpose();
+      if (fi >= 0 && fj < 0) rhs.row(fi) += input[j].transpose();
+      if (fj >= 0 && fi < 0) rhs.row(fj) += input[i].transpose();
+    }
+    Eigen::MatrixX3d x(freeCount, 3);
+    for (int c = 0; c < 3; ++c) x.col(c) = factor.solve(rhs.col(c));
+    if (factor.info() != Eigen::Success) throw NumericalError(kStage, "Phase II solve failed");
+    for (int v = 0; v < n; ++v) {
+      if (freeIndex[v] >= 0) out[v] = x.row(freeIndex[v]).transpose();
+    }
+  }
+  for (const auto& comp : floatingComponents) {
+    Vec3 shift = Vec3::Zero();
+    for (int v : comp) shift += input[v] - out[v];
+    shift /= static_cast<double>(comp.size());
+    for (int v : comp) out[v] += shift;
+  }
+  for (int v = 0; v < n; ++v) {
+    if (!finite(out[v])) {
+      throw NumericalError(
+          kStage, "Phase II produced a non-finite position at vertex " + std::to_string(v));
+    }
+  }
+  return out;
+}
+
+IsometryProjector::IsometryProjector(std::vector<Vec2> pattern,
+                                     std::vector<std::array<int, 3>> triangles,
+                                     std::vector<int> fixedVertices, IsometryOptions options)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->pattern = std::move(pattern);
+  impl_->triangles = std::move(triangles);
+  impl_->fixed = std::move(fixedVertices);
+  impl_->options = options;
+  impl_->build();
+}
+
+IsometryProjector::~IsometryProjector() = default;
+IsometryProjector::IsometryProjector(IsometryProjector&&) noexcept = default;
+IsometryProjector& IsometryProjector::operator=(IsometryProjector&&) noexcept = default;
+
+int IsometryProjector::vertexCount() const { return impl_->n; }
+int IsometryProjector::edgeCount() const { return static_cast<int>(impl_->edges.size()); }
+
+bool IsometryProjector::sameTopology(const std::vector<std::array<int, 3>>& triangles,
+                                     const std::vector<int>& fixedVertices) const {
+  if (triangles != impl_->triangles) return false;
+  std::vector<int> f = fixedVertices;
+  std::sort(f.begin(), f.end());
+  f.erase(std::unique(f.begin(), f.end()), f.end());
+  return f == impl_->fixed;
+}
+
+// Paper Sec. 6.3: Phase I (eqs. (3)-(6)) then Phase II (eq. (7)), `rounds` times.
+IsometryStats IsometryProjector::project(std::vector<Vec3>& positions, int maxIterations) const {
+  const Impl& im = *impl_;
+  if (maxIterations < 0) throw std::invalid_argument("isometry: negative iteration cap");
+  if (static_cast<int>(positions.size()) != im.n) {
+    throw NumericalError(kStage, "expected " + std::to_string(im.n) + " positions, got " +
+                                     std::to_string(positions.size()));
+  }
+  for (int v = 0; v < im.n; ++v) {
+    if (!finite(positions[v])) {
+      throw NumericalError(kStage, "non-finite input position at vertex " + std::to_string(v));
+    }
+  }
+  const std::size_t m = im.edges.size();
+  auto lengthErrors = [&](const std::vector<Vec3>& p, double& mean, double& max) {
+    mean = 0.0;
+    max = 0.0;
+    for (std::size_t e = 0; e < m; ++e) {
+      const double l = (p[im.edges[e][1]] - p[im.edges[e][0]]).norm();
+      const double err = std::abs(l - im.restLength[e]) / im.restLength[e];
+      mean += err;
+      max = std::max(max, err);
+    }
+    if (m > 0) mean /= static_cast<double>(m);
+  };
+  IsometryStats stats;
+  double dummy = 0.0;
+  lengthErrors(positions, stats.meanLengthErrorBefore, dummy);
+
+  std::vector<Vec3> current = positions;
+  std::vector<Vec3> u0(m), u(m);
+  for (int round = 0; round < im.options.rounds; ++round) {
+    // u0: the current normalised edge directions (the start of Phase I).
+    for (std::size_t e = 0; e < m; ++e) {
+      const Vec3 d = current[im.edges[e][1]] - current[im.edges[e][0]];
+      const double len = d.norm();
+      if (!(len > 1e-14 * im.restLength[e])) {
+        throw NumericalError(kStage, "edge (" + std::to_string(im.edges[e][0]) + ", " +
+                                         std::to_string(im.edges[e][1]) +
+                                         ") has collapsed to zero length");
+      }
+      u0[e] = d / len;
+    }
+    u = u0;
+    stats.phaseOneIterations += im.phaseOne(u0, u, maxIterations);
+    // Renormalise (deviation 2 in the header); an edge whose direction did not
+    // survive Phase I keeps its input direction.
+    for (std::size_t e = 0; e < m; ++e) {
+      const double len = u[e].norm();
+      u[e] = std::isfinite(len) && len > 0.5 && len < 2.0 ? Vec3(u[e] / len) : u0[e];
+    }
+    current = im.phaseTwo(current, u);
+  }
+
+  lengthErrors(current, stats.meanLengthErrorAfter, stats.maxLengthErrorAfter);
+  double disp = 0.0;
+  for (int v = 0; v < im.n; ++v) disp += (current[v] - positions[v]).norm();
+  stats.meanDisplacement = im.n > 0 ? disp / im.n : 0.0;
+  positions = std::move(current);
+  return stats;
+}
+
+}  // namespace crumple::paper

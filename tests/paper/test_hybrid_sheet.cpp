@@ -1,0 +1,125 @@
+// The hybrid model's step on small hand-driven cases (scene-level behaviour
+// is tested on the samples in tests/pipeline/test_crumpling_samples.cpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "crumple/paper/hybrid_sheet.hpp"
+#include "crumple/paper/initial_sheet.hpp"
+
+using namespace crumple;
+using namespace crumple::paper;
+
+namespace {
+
+constexpr double kL = 0.10;
+
+sim::SimParams weightless() {
+  sim::SimParams p;
+  p.gravity = Vec3::Zero();
+  return p;
+}
+
+CrumpleParams checked() {
+  CrumpleParams p;
+  p.checkInvariants = true;
+  return p;
+}
+
+}  // namespace
+
+// A sheet held still at its corners and without gravity stays one flat
+// region: the model adds nothing when nothing is compressed.
+TEST(HybridSheet, RestingSheetStaysOneFlatRegion) {
+  InitialSheet sheet = makeFlatSheet(kL, kL, {Vec2(0, 0), Vec2(kL, 0), Vec2(kL, kL), Vec2(0, kL)},
+                                     Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
+  HybridSheet hybrid(sheet.mesh, sim::Material{}, weightless(), checked(), 1);
+  const auto pins = [&](double, std::vector<sim::Pin>& out) {
+    out.clear();
+    for (int v : sheet.handleVertices)
+      out.push_back({v, sheet.mesh.vertices[static_cast<std::size_t>(v)].position});
+  };
+  for (int f = 0; f < 5; ++f) hybrid.advance(f / 24.0, 1.0 / 24.0, 2, pins, f + 1);
+  ASSERT_EQ(hybrid.geometric().regions.size(), 1u);
+  EXPECT_EQ(hybrid.geometric().regions[0].type, mesh::RegionType::Flat);
+  EXPECT_EQ(hybrid.singularVertexCount(), 0);
+  for (const Vec3& x : hybrid.physical().mesh.positions) EXPECT_NEAR(x.z(), 0.0, 1e-12);
+}
+
+// Two opposite edges pushed towards each other with their tangent planes
+// turning (a wrap): the compressed flat region becomes a curved region of
+// rulings parallel to the held edges, with no singular vertex, and S_P
+// stays close to isometric. Every handle vertex follows its pin exactly.
+TEST(HybridSheet, WrapCreatesParallelRulingsAndStaysIsometric) {
+  // Handles: the 4 corners; each edge x = 0 and x = L turns about its own
+  // line and moves inwards so the cross-section becomes a circular arc.
+  const std::vector<Vec2> corners{Vec2(0, 0), Vec2(kL, 0), Vec2(kL, kL), Vec2(0, kL)};
+  InitialSheet sheet = makeFlatSheet(kL, kL, corners, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
+  const double total = std::numbers::pi / 2.0;  // the arc spans 90 degrees at the end
+  const auto arc = [&](double x, double angle) {
+    // Arc of length L centred on the sheet's middle, bent about the y axis.
+    if (angle < 1e-9) return Vec3(x, 0.0, 0.0);
+    const double r = kL / angle;
+    const double a = (x - 0.5 * kL) / r;
+    return Vec3(0.5 * kL + r * std::sin(a), 0.0, r * (1.0 - std::cos(a)));
+  };
+  const auto pins = [&](double t, std::vector<sim::Pin>& out) {
+    const double s = std::clamp(t / 1.0, 0.0, 1.0);
+    const double angle = total * s * s * (3.0 - 2.0 * s);
+    out.clear();
+    for (std::size_t k = 0; k < corners.size(); ++k) {
+      out.push_back(
+          {sheet.handleVertices[k], arc(corners[k].x(), angle) + Vec3(0.0, corners[k].y(), 0.0)});
+    }
+  };
+  HybridSheet hybrid(sheet.mesh, sim::Material{}, weightless(), checked(), 7);
+  double worst = 0.0;
+  for (int f = 0; f < 30; ++f) {
+    const HybridStepStats st = hybrid.advance(f / 24.0, 1.0 / 24.0, 4, pins, f + 1);
+    worst = std::max(worst, st.isometry.meanLengthErrorAfter);
+    std::vector<sim::Pin> target;
+    pins((f + 1) / 24.0, target);
+    for (const sim::Pin& p : target) {
+      EXPECT_LT((hybrid.physical().mesh.positions[static_cast<std::size_t>(p.vertex)] - p.position)
+                    .norm(),
+                1e-12);
+    }
+  }
+  EXPECT_EQ(hybrid.singularVertexCount(), 0);
+  int curved = 0;
+  for (const Region& r : hybrid.geometric().regions) {
+    if (r.type != mesh::RegionType::Curved) continue;
+    ++curved;
+    for (const Ruling& ruling : r.rulings) {
+      const Vec2 d = hybrid.geometric().vertices[static_cast<std::size_t>(ruling.b)].pattern -
+                     hybrid.geometric().vertices[static_cast<std::size_t>(ruling.a)].pattern;
+      EXPECT_LT(std::abs(d.x()) / d.norm(), std::sin(5.0 * std::numbers::pi / 180.0));
+    }
+  }
+  EXPECT_GE(curved, 1);
+  EXPECT_LT(worst, 0.005);
+  ::testing::Test::RecordProperty("worst_c_mean", std::to_string(worst));
+}
+
+// Same input, same seed: bit-identical S_P.
+TEST(HybridSheet, Deterministic) {
+  const std::vector<Vec2> corners{Vec2(0, 0), Vec2(kL, 0), Vec2(kL, kL), Vec2(0, kL)};
+  const auto run = [&] {
+    InitialSheet sheet = makeFlatSheet(kL, kL, corners, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
+    HybridSheet hybrid(sheet.mesh, sim::Material{}, weightless(), checked(), 3);
+    const auto pins = [&](double t, std::vector<sim::Pin>& out) {
+      out.clear();
+      for (std::size_t k = 0; k < corners.size(); ++k) {
+        const double squeeze = corners[k].x() < 0.5 * kL ? 0.01 * t : -0.01 * t;
+        out.push_back(
+            {sheet.handleVertices[k], Vec3(corners[k].x() + squeeze, corners[k].y(), 0.002 * t)});
+      }
+    };
+    for (int f = 0; f < 12; ++f) hybrid.advance(f / 24.0, 1.0 / 24.0, 2, pins, f + 1);
+    return hybrid.physical().mesh.positions;
+  };
+  const auto a = run();
+  const auto b = run();
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i], b[i]);
+}
