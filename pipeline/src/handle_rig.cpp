@@ -156,21 +156,21 @@ void HandleRig::pins(double t, std::vector<sim::Pin>& out) const {
   }
 }
 
-void HandleRig::rebindTangents(const mesh::SheetMesh& sheet,
-                               const std::function<Vec3(const Vec2&)>& rest) {
+void HandleRig::rebindTangents(const mesh::SheetMesh& sheet, double t) {
   std::vector<char> held(sheet.vertexCount(), 0);
   for (const auto& h : handles_) held[static_cast<std::size_t>(h.vertex)] = 1;
   for (auto& h : handles_) {
     if (h.tangentCount < 0) continue;
     h.tangentVertices.clear();
     h.tangentOffsets.clear();
-    const Vec3 base = rest(sheet.pattern[static_cast<std::size_t>(h.vertex)]);
+    if (h.releases && t >= h.releaseTime) continue;
+    const Pose pose = animation_->worldPose(h.node, t);
     for (int n : tangentNeighbours(sheet, h.vertex, h.tangentCount)) {
       if (held[static_cast<std::size_t>(n)]) continue;  // another handle's vertex
       held[static_cast<std::size_t>(n)] = 1;
       h.tangentVertices.push_back(n);
-      h.tangentOffsets.push_back(h.bindRotation.conjugate() *
-                                 (rest(sheet.pattern[static_cast<std::size_t>(n)]) - base));
+      h.tangentOffsets.push_back(pose.rotation.conjugate() *
+                                 (sheet.positions[static_cast<std::size_t>(n)] - pose.position));
     }
   }
 }

@@ -368,12 +368,9 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     std::vector<sim::Pin> start;
     rig.pins(t0, start);
     hybrid->placeVertices(start);
-    const Vec3 origin = scene.sheet.origin;
-    const Vec3 u = scene.sheet.uAxis.normalized();
-    const Vec3 v = scene.sheet.vAxis.normalized();
-    hybrid->setRebuildCallback([&rig, origin, u, v](const mesh::SheetMesh& sp) {
-      rig.rebindTangents(sp, [&](const Vec2& p) { return Vec3(origin + p.x() * u + p.y() * v); });
-    });
+    hybrid->setTime(t0);
+    hybrid->setRebuildCallback(
+        [&rig](const mesh::SheetMesh& sp, double t) { rig.rebindTangents(sp, t); });
   }
   for (int f = scene.frameStart; f <= range.last; ++f)
     (void)cameraAt(scene, animation.get(), frameTime(scene, f));
@@ -530,6 +527,8 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   } catch (const NumericalError& e) {
     progress.finish();
     report.error = e.what();
+    report.hybrid = hybridModel;
+    if (report.framesSimulated > 0) report.meanCMean /= report.framesSimulated;
     writer.close();  // the cache stays valid up to the last good frame
     writeTextAtomically(report.summaryPath, summaryJson(scene, report));
     throw;

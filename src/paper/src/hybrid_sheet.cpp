@@ -42,28 +42,31 @@ struct HybridSheet::Impl {
   std::optional<IsometryProjector> isometry;
   std::vector<Vec3> spVelocities;
   double paperLength = 0.0;
-  std::function<void(const mesh::SheetMesh&)> onRebuild;
-  // Faces (by the pattern positions of their vertices) at the end of each of
-  // the last remeshCooldown steps, oldest first.
-  std::deque<std::set<std::vector<std::int64_t>>> faceHistory;
+  std::function<void(const mesh::SheetMesh&, double)> onRebuild;
+  double time = 0.0;  // time S_G and S_P are at
+  // Where compression was treated in the last remeshCooldown steps, and how
+  // many more steps each point blocks remeshing of the region holding it.
+  std::vector<std::pair<Vec2, int>> recentCuts;
 
-  std::vector<std::int64_t> faceKey(const GeometricFace& f) const {
-    std::vector<std::array<std::int64_t, 2>> corners;
-    for (int k = 0; k < f.size(); ++k) {
-      const Vec2& p = sg.vertices[static_cast<std::size_t>(f.v[k])].pattern;
-      corners.push_back({std::llround(p.x() * 1e9), std::llround(p.y() * 1e9)});
+  // Whether face f holds a recent cut (pattern point in polygon).
+  bool holdsRecentCut(const GeometricFace& f) const {
+    for (const auto& [p, left] : recentCuts) {
+      bool inside = false;
+      const int n = f.size();
+      for (int k = 0; k < n; ++k) {
+        if ((sg.vertices[static_cast<std::size_t>(f.v[k])].pattern - p).norm() < 1e-9) return true;
+      }
+      for (int k = 0; k < n; ++k) {
+        const Vec2& a = sg.vertices[static_cast<std::size_t>(f.v[k])].pattern;
+        const Vec2& b = sg.vertices[static_cast<std::size_t>(f.v[(k + 1) % n])].pattern;
+        if ((a.y() > p.y()) != (b.y() > p.y()) &&
+            a.x() + (p.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y()) > p.x()) {
+          inside = !inside;
+        }
+      }
+      if (inside) return true;
     }
-    std::sort(corners.begin(), corners.end());
-    std::vector<std::int64_t> key;
-    for (const auto& c : corners) key.insert(key.end(), c.begin(), c.end());
-    return key;
-  }
-  void rememberFaces() {
-    std::set<std::vector<std::int64_t>> keys;
-    for (const GeometricFace& f : sg.faces) keys.insert(faceKey(f));
-    faceHistory.push_back(std::move(keys));
-    while (faceHistory.size() > static_cast<std::size_t>(std::max(params.remeshCooldown, 1)))
-      faceHistory.pop_front();
+    return false;
   }
 
   // S_P from S_G (paper Sec. 4, Fig. 16 (g)) with fiber damage (thesis 2.3.3).
@@ -92,7 +95,7 @@ struct HybridSheet::Impl {
       elastic->setHingeRestAngle(h, damage[h].restAngle);
       elastic->setHingeStiffnessFactor(h, damage[h].stiffnessFactor);
     }
-    if (onRebuild) onRebuild(sp.mesh);
+    if (onRebuild) onRebuild(sp.mesh, time);
     return !same;
   }
 
@@ -130,9 +133,7 @@ HybridSheet::HybridSheet(GeometricMesh sg, const sim::Material& material,
   m.material = material;
   m.simParams = simParams;
   m.simParams.membraneScale = params.membraneScale;
-  if (const char* e = std::getenv("CRUMPLE_EXP_TOL")) m.simParams.newtonTolerance = std::atof(e);
-  if (const char* e = std::getenv("CRUMPLE_EXP_IT")) m.simParams.maxNewtonIterations = std::atoi(e);
-  if (const char* e = std::getenv("CRUMPLE_EXP_MS")) m.simParams.membraneScale = std::atof(e);
+  m.simParams.minVertexMassFraction = params.minVertexMassFraction;
   m.params = params;
   m.seed = seed;
   for (const Vec2& a : m.sg.outline) {
@@ -147,9 +148,10 @@ HybridSheet::~HybridSheet() = default;
 HybridSheet::HybridSheet(HybridSheet&&) noexcept = default;
 HybridSheet& HybridSheet::operator=(HybridSheet&&) noexcept = default;
 
-void HybridSheet::setRebuildCallback(std::function<void(const mesh::SheetMesh&)> callback) {
+void HybridSheet::setRebuildCallback(
+    std::function<void(const mesh::SheetMesh&, double t)> callback) {
   impl_->onRebuild = std::move(callback);
-  if (impl_->onRebuild) impl_->onRebuild(impl_->sp.mesh);
+  if (impl_->onRebuild) impl_->onRebuild(impl_->sp.mesh, impl_->time);
 }
 
 void HybridSheet::placeVertices(const std::vector<sim::Pin>& pins) {
@@ -164,6 +166,8 @@ void HybridSheet::placeVertices(const std::vector<sim::Pin>& pins) {
     m.sp.mesh.positions[static_cast<std::size_t>(p.vertex)] = p.position;
   m.elastic->setPositions(m.sp.mesh.positions);
 }
+
+void HybridSheet::setTime(double t) { impl_->time = t; }
 
 const GeometricMesh& HybridSheet::geometric() const { return impl_->sg; }
 const PhysicalMesh& HybridSheet::physical() const { return impl_->sp; }
@@ -232,12 +236,9 @@ HybridStepStats HybridSheet::advance(double t, double dt, int substeps,
     checkAfter("flat-region splits");
     const CounterRng rng(m.seed, frame, RngPurpose::SingularityPlacement);
     std::uint64_t draw = 0;
-    // A face may be remeshed once it has existed for remeshCooldown steps.
+    // Regions cut in the last remeshCooldown steps wait (the cooldown).
     const FaceFilter settled = [&m](int face) {
-      if (m.params.remeshCooldown <= 0) return true;
-      if (m.faceHistory.size() < static_cast<std::size_t>(m.params.remeshCooldown))
-        return true;  // start
-      return m.faceHistory.front().contains(m.faceKey(m.sg.faces[static_cast<std::size_t>(face)]));
+      return !m.holdsRecentCut(m.sg.faces[static_cast<std::size_t>(face)]);
     };
     treatCompression(m.sg, m.params, boundary, rng, draw, stats.geometric, settled);
     checkAfter("compression treatment");
@@ -278,6 +279,7 @@ HybridStepStats HybridSheet::advance(double t, double dt, int substeps,
       if (!problem.empty())
         throw NumericalError("geometric", frame, "S_G invariant broken: " + problem);
     }
+    m.time = t + dt;
     // (g) S_P from S_G.
     stage = "rebuild";
     t0 = Clock::now();
@@ -311,7 +313,10 @@ HybridStepStats HybridSheet::advance(double t, double dt, int substeps,
     m.sp.mesh.positions = positions;
     for (std::size_t i = 0; i < m.sg.vertices.size(); ++i) m.sg.vertices[i].position = positions[i];
     m.elastic->setPositions(positions);
-    m.rememberFaces();
+    for (auto& cut : m.recentCuts) --cut.second;
+    std::erase_if(m.recentCuts, [](const auto& cut) { return cut.second <= 0; });
+    for (const Vec2& p : stats.geometric.cuts)
+      m.recentCuts.emplace_back(p, m.params.remeshCooldown);
     stats.ms.isometry = msSince(t0);
     if (const char* env = std::getenv("CRUMPLE_DEBUG_GEOMETRY"); env != nullptr && env[0] == '1') {
       // Developer trace of the geometric step, one line per frame.
@@ -328,6 +333,11 @@ HybridStepStats HybridSheet::advance(double t, double dt, int substeps,
                    gs.singularInserted, gs.creases, gs.junctionMoves, gs.curvedFlattened,
                    gs.maxCompression, stats.isometry.meanLengthErrorBefore,
                    stats.isometry.meanLengthErrorAfter);
+      double vmax = 0.0;
+      for (const Vec3& vv : m.elastic->velocities()) vmax = std::max(vmax, vv.norm());
+      std::fprintf(stderr,
+                   "[geometry]   max speed %.3g m/s, isometry displacement %.3g m, halvings %d\n",
+                   vmax, stats.isometry.meanDisplacement, stats.elastic.halvings);
       for (const std::string& note : gs.notes)
         std::fprintf(stderr, "[geometry]   %s\n", note.c_str());
     }
@@ -350,6 +360,7 @@ HybridStepStats HybridSheet::advance(double t, double dt, int substeps,
       }
     }
     m.sg = sgBefore;
+    m.time = t;
     m.elastic.reset();
     m.isometry.reset();
     m.rebuildPhysical();

@@ -294,7 +294,14 @@ void updateJunctions(GeometricMesh& g, const CrumpleParams& params,
         if (!flatOutside(k) || !(angle[k] > params.thetaHigh)) continue;
         const int flat = g.faces[static_cast<std::size_t>(outside[k])].region;
         const GeometricMesh before = g;
-        if (expandIntoFlat(g, region, front, flat, angle[k], params, boundary)) {
+        bool moved = false;
+        try {
+          moved = expandIntoFlat(g, region, front, flat, angle[k], params, boundary);
+        } catch (const std::exception& e) {
+          g = before;
+          stats.notes.push_back(std::string("junction move undone (") + e.what() + ")");
+        }
+        if (moved) {
           if (const std::string problem = validate(g); !problem.empty()) {
             g = before;
             stats.notes.push_back("junction move undone (" + problem + ")");

@@ -780,6 +780,7 @@ void treatCurvedCompression(GeometricMesh& g, const CrumpleParams& params, const
   for (std::size_t r = 0; r < regionCount; ++r) {
     if (g.regions[r].type != mesh::RegionType::Curved || g.regions[r].apex >= 0) continue;
     if (!settled[r]) continue;
+    if (stats.singularInserted >= params.maxSingularPerStep) break;
     if (g.regions[r].rulings.size() < 2) continue;
     const std::vector<Ruling> rulings = orientedRulings(g, g.regions[r].rulings);
     const auto P = [&](int v) -> const Vec2& {
@@ -870,48 +871,56 @@ void treatCurvedCompression(GeometricMesh& g, const CrumpleParams& params, const
       }
     }
     const GeometricMesh before = g;
-    const int sIndex = addVertex(g, sv);
-    const int cr = static_cast<int>(r);
-    removeRegionFaces(g, cr);
-    // What stays of C: the rulings before lo and after hi (two curved regions).
-    g.regions[r].rulings.assign(rulings.begin() + static_cast<std::ptrdiff_t>(hi), rulings.end());
-    if (g.regions[r].rulings.size() >= 2) rebuildCurvedFaces(g, cr);
-    if (lo >= 1) {
-      const int back = addRegion(g, mesh::RegionType::Curved);
-      g.regions[static_cast<std::size_t>(back)].rulings.assign(
-          rulings.begin(), rulings.begin() + static_cast<std::ptrdiff_t>(lo) + 1);
-      rebuildCurvedFaces(g, back);
-    }
-    // Fans from s to both chains between r_lo and r_hi.
-    for (int chain = 0; chain < 2; ++chain) {
-      std::vector<Ruling> fan;
-      for (std::size_t k = lo; k <= hi; ++k) {
-        const int end = chain == 0 ? rulings[k].a : rulings[k].b;
-        if (!fan.empty() && fan.back().b == end) continue;
-        fan.push_back({sIndex, end});
+    try {
+      const int sIndex = addVertex(g, sv);
+      const int cr = static_cast<int>(r);
+      removeRegionFaces(g, cr);
+      // What stays of C: the rulings before lo and after hi (two curved regions).
+      g.regions[r].rulings.assign(rulings.begin() + static_cast<std::ptrdiff_t>(hi), rulings.end());
+      if (g.regions[r].rulings.size() >= 2) rebuildCurvedFaces(g, cr);
+      if (lo >= 1) {
+        const int back = addRegion(g, mesh::RegionType::Curved);
+        g.regions[static_cast<std::size_t>(back)].rulings.assign(
+            rulings.begin(), rulings.begin() + static_cast<std::ptrdiff_t>(lo) + 1);
+        rebuildCurvedFaces(g, back);
       }
-      if (fan.size() < 2) continue;
-      const int fr = addRegion(g, mesh::RegionType::Curved);
-      g.regions[static_cast<std::size_t>(fr)].rulings = fan;
-      g.regions[static_cast<std::size_t>(fr)].apex = sIndex;
-      rebuildCurvedFaces(g, fr);
-    }
-    const auto addTriangle = [&](int a, int b, int c, int region) {
-      GeometricFace f;
-      f.v = {a, b, c, -1};
-      if (cross2(P(b) - P(a), P(c) - P(a)) < 0.0) std::swap(f.v[1], f.v[2]);
-      f.region = region;
-      g.faces.push_back(f);
-    };
-    addTriangle(sIndex, rulings[lo].a, rulings[lo].b, addRegion(g, mesh::RegionType::Flat));
-    addTriangle(sIndex, rulings[hi].a, rulings[hi].b, addRegion(g, mesh::RegionType::Flat));
-    if (const std::string problem = validate(g); !problem.empty()) {
+      // Fans from s to both chains between r_lo and r_hi.
+      for (int chain = 0; chain < 2; ++chain) {
+        std::vector<Ruling> fan;
+        for (std::size_t k = lo; k <= hi; ++k) {
+          const int end = chain == 0 ? rulings[k].a : rulings[k].b;
+          if (!fan.empty() && fan.back().b == end) continue;
+          fan.push_back({sIndex, end});
+        }
+        if (fan.size() < 2) continue;
+        const int fr = addRegion(g, mesh::RegionType::Curved);
+        g.regions[static_cast<std::size_t>(fr)].rulings = fan;
+        g.regions[static_cast<std::size_t>(fr)].apex = sIndex;
+        rebuildCurvedFaces(g, fr);
+      }
+      const auto addTriangle = [&](int a, int b, int c, int region) {
+        GeometricFace f;
+        f.v = {a, b, c, -1};
+        if (cross2(P(b) - P(a), P(c) - P(a)) < 0.0) std::swap(f.v[1], f.v[2]);
+        f.region = region;
+        g.faces.push_back(f);
+      };
+      addTriangle(sIndex, rulings[lo].a, rulings[lo].b, addRegion(g, mesh::RegionType::Flat));
+      addTriangle(sIndex, rulings[hi].a, rulings[hi].b, addRegion(g, mesh::RegionType::Flat));
+      if (const std::string problem = validate(g); !problem.empty()) {
+        g = before;
+        stats.notes.push_back("curved region " + std::to_string(r) + ": d-cone undone (" + problem +
+                              ")");
+        continue;
+      }
+    } catch (const std::exception& e) {
       g = before;
-      stats.notes.push_back("curved region " + std::to_string(r) + ": d-cone undone (" + problem +
+      stats.notes.push_back("curved region " + std::to_string(r) + ": d-cone undone (" + e.what() +
                             ")");
       continue;
     }
     ++stats.singularInserted;
+    stats.cuts.push_back(s);
   }
   compact(g);
 }
@@ -953,7 +962,13 @@ int bendFoldedFlatRegions(GeometricMesh& g, const CrumpleParams& params,
     pencil.origin = 0.5 * (a + b);
     pencil.dir = (b - a).normalized();
     const GeometricMesh before = g;
-    StripResult result = remeshStrip(g, static_cast<int>(r), pencil, params, boundary);
+    StripResult result;
+    try {
+      result = remeshStrip(g, static_cast<int>(r), pencil, params, boundary);
+    } catch (const std::exception& e) {
+      g = before;
+      result = {false, e.what()};
+    }
     if (result.done) {
       if (const std::string problem = validate(g); !problem.empty()) {
         g = before;
@@ -992,7 +1007,31 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
     bool changed = false;
     const std::size_t regionCount = g.regions.size();
     declined.resize(regionCount, 0);
-    for (std::size_t r = 0; r < regionCount; ++r) {
+    // Most compressed regions first, so the per-step budget of singular
+    // vertices goes where the conflict is strongest.
+    std::vector<std::pair<double, std::size_t>> order;
+    {
+      std::vector<double> worst(regionCount, 0.0);
+      for (const GeometricFace& face : g.faces) {
+        if (face.size() != 3 ||
+            g.regions[static_cast<std::size_t>(face.region)].type != mesh::RegionType::Flat) {
+          continue;
+        }
+        std::array<Vec2, 3> pat;
+        std::array<Vec3, 3> pos;
+        for (int k = 0; k < 3; ++k) {
+          pat[static_cast<std::size_t>(k)] =
+              g.vertices[static_cast<std::size_t>(face.v[k])].pattern;
+          pos[static_cast<std::size_t>(k)] =
+              g.vertices[static_cast<std::size_t>(face.v[k])].position;
+        }
+        double& w = worst[static_cast<std::size_t>(face.region)];
+        w = std::max(w, analyzeCompression(pat, pos).ratio());
+      }
+      for (std::size_t r = 0; r < regionCount; ++r) order.emplace_back(-worst[r], r);
+      std::sort(order.begin(), order.end());
+    }
+    for (const auto& [negWorst, r] : order) {
       if (declined[r] || g.regions[r].type != mesh::RegionType::Flat) continue;
       // (a) the most compressed triangle and its direction of minimal compression.
       int tcomp = -1;
@@ -1035,115 +1074,137 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
         declined.resize(g.regions.size(), 0);
         declined[r] = 1;
       };
-      // (b) the borders of the strip along +-v_perp (Appendix A, Fig. 6).
-      const EdgeMap edges = edgeMap(g);
-      const auto loop = regionLoop(g, static_cast<int>(r), edges);
-      if (!loop) {
-        declined[r] = 1;
-        continue;
-      }
-      const double tol = 1e-10 * std::sqrt(outlineArea(g));
-      const Border fwd = findBorder(g, *loop, centroid, best.vPerp, tol);
-      const Border bwd = findBorder(g, *loop, centroid, -best.vPerp, tol);
-      std::ostringstream why;
-      why << "flat region " << r << " compressed " << best.ratio() << ": ";
-      if (fwd.kind == Border::Kind::None || bwd.kind == Border::Kind::None) {
-        why << "strip ends on a vertex that is not on the sheet boundary";
-        stats.notes.push_back(why.str());
-        declined[r] = 1;
-        continue;
-      }
-      // (c) remesh: c1 with both borders free, c2 with singular vertices.
-      const auto constrained = [](const Border& b) { return b.kind != Border::Kind::Free; };
-      int singular[2] = {-1, -1};
-      const Border* borders[2] = {&bwd, &fwd};
-      // Singular vertices on constrained borders (paper Sec. 5.2). A border
-      // ruling of a curved region gets its singular vertex on the ruling
-      // itself (we do not yet continue into the curved region to e_sing).
-      // A border ruling of a cone from a singular vertex s: the strip's
-      // rulings are attracted by s itself (Appendix B, Fig. 24 b), no new
-      // singular vertex is needed.
-      bool feasible = true;
-      int existingApex[2] = {-1, -1};
-      for (int side = 0; side < 2; ++side) {
-        const Border& b = *borders[side];
-        if (b.kind != Border::Kind::Curved) continue;
-        const int across = loop->across[static_cast<std::size_t>(b.loopEdge)];
-        const int apex =
-            g.regions[static_cast<std::size_t>(g.faces[static_cast<std::size_t>(across)].region)]
-                .apex;
-        if (apex < 0) continue;
-        const int ea = loop->v[static_cast<std::size_t>(b.loopEdge)];
-        const int eb = loop->next(static_cast<std::size_t>(b.loopEdge));
-        if (apex == ea || apex == eb) {
-          existingApex[side] = apex;
-        } else {
-          feasible = false;
-        }
-      }
-      if (!feasible) {
-        why << "the strip meets a conical curved region";
-        stats.notes.push_back(why.str());
-        declined[r] = 1;
-        continue;
-      }
-      for (int side = 0; side < 2; ++side) {
-        if (existingApex[side] >= 0) {
-          singular[side] = existingApex[side];
+      try {
+        // (b) the borders of the strip along +-v_perp (Appendix A, Fig. 6).
+        const EdgeMap edges = edgeMap(g);
+        const auto loop = regionLoop(g, static_cast<int>(r), edges);
+        if (!loop) {
+          declined[r] = 1;
           continue;
         }
-        if (!constrained(*borders[side])) continue;
-        const EdgeMap e2 = edgeMap(g);
-        const auto l2 = regionLoop(g, static_cast<int>(r), e2);
-        if (!l2) break;
-        // Re-locate the border edge in the current loop (the other side's
-        // insertion may have renumbered it).
-        const Border b =
-            findBorder(g, *l2, centroid, side == 0 ? Vec2(-best.vPerp) : best.vPerp, tol);
-        if (b.kind == Border::Kind::Curved) {
-          singular[side] =
-              insertSingularInCurved(g, static_cast<int>(r), *l2, b, params, rng, drawIndex);
-          if (singular[side] < 0) break;
-        } else {
-          singular[side] = placeSingularOnBorder(g, *l2, b, params, rng, drawIndex);
+        const double tol = 1e-10 * std::sqrt(outlineArea(g));
+        const Border fwd = findBorder(g, *loop, centroid, best.vPerp, tol);
+        const Border bwd = findBorder(g, *loop, centroid, -best.vPerp, tol);
+        std::ostringstream why;
+        why << "flat region " << r << " compressed " << best.ratio() << ": ";
+        if (fwd.kind == Border::Kind::None || bwd.kind == Border::Kind::None) {
+          why << "strip ends on a vertex that is not on the sheet boundary";
+          stats.notes.push_back(why.str());
+          declined[r] = 1;
+          continue;
         }
-        ++stats.singularInserted;
-      }
-      if ((constrained(bwd) && singular[0] < 0) || (constrained(fwd) && singular[1] < 0)) {
-        why << "the strip meets a conical curved region";
-        stats.notes.push_back(why.str());
-        declined[r] = 1;
-        continue;
-      }
-      StripResult result;
-      if (singular[0] >= 0 && singular[1] >= 0) {
-        result.done = splitAlongCrease(g, static_cast<int>(r), singular[0], singular[1]);
-        if (result.done) ++stats.creases;
-      } else {
-        Pencil pencil;
-        if (singular[0] >= 0 || singular[1] >= 0) {
-          pencil.apex = singular[0] >= 0 ? singular[0] : singular[1];
-          const Vec2 s = g.vertices[static_cast<std::size_t>(pencil.apex)].pattern;
-          pencil.origin = s;
-          pencil.dir = (centroid - s).normalized();
-        } else {
-          pencil.origin = centroid;
-          pencil.dir = best.vPerp;
+        // (c) remesh: c1 with both borders free, c2 with singular vertices.
+        const auto constrained = [](const Border& b) { return b.kind != Border::Kind::Free; };
+        int singular[2] = {-1, -1};
+        const Border* borders[2] = {&bwd, &fwd};
+        // Singular vertices on constrained borders (paper Sec. 5.2). A border
+        // ruling of a curved region gets its singular vertex on the ruling
+        // itself (we do not yet continue into the curved region to e_sing).
+        // A border ruling of a cone from a singular vertex s: the strip's
+        // rulings are attracted by s itself (Appendix B, Fig. 24 b), no new
+        // singular vertex is needed.
+        bool feasible = true;
+        int existingApex[2] = {-1, -1};
+        for (int side = 0; side < 2; ++side) {
+          const Border& b = *borders[side];
+          if (b.kind != Border::Kind::Curved) continue;
+          const int across = loop->across[static_cast<std::size_t>(b.loopEdge)];
+          const int apex =
+              g.regions[static_cast<std::size_t>(g.faces[static_cast<std::size_t>(across)].region)]
+                  .apex;
+          if (apex < 0) continue;
+          const int ea = loop->v[static_cast<std::size_t>(b.loopEdge)];
+          const int eb = loop->next(static_cast<std::size_t>(b.loopEdge));
+          if (apex == ea || apex == eb) {
+            existingApex[side] = apex;
+          } else {
+            feasible = false;
+          }
         }
-        result = remeshStrip(g, static_cast<int>(r), pencil, params, boundary);
-        if (result.done) ++stats.curvedCreated;
-      }
-      if (!result.done) {
-        why << result.note;
-        stats.notes.push_back(why.str());
-        declined[r] = 1;
+        if (!feasible) {
+          why << "the strip meets a conical curved region";
+          stats.notes.push_back(why.str());
+          declined[r] = 1;
+          continue;
+        }
+        const int needed = (constrained(bwd) && existingApex[0] < 0 ? 1 : 0) +
+                           (constrained(fwd) && existingApex[1] < 0 ? 1 : 0);
+        if (needed > 0 && stats.singularInserted + needed > params.maxSingularPerStep) {
+          why << "singular-vertex budget of this step used up";
+          stats.notes.push_back(why.str());
+          declined[r] = 1;
+          continue;
+        }
+        for (int side = 0; side < 2; ++side) {
+          if (existingApex[side] >= 0) {
+            singular[side] = existingApex[side];
+            continue;
+          }
+          if (!constrained(*borders[side])) continue;
+          const EdgeMap e2 = edgeMap(g);
+          const auto l2 = regionLoop(g, static_cast<int>(r), e2);
+          if (!l2) break;
+          // Re-locate the border edge in the current loop (the other side's
+          // insertion may have renumbered it).
+          const Border b =
+              findBorder(g, *l2, centroid, side == 0 ? Vec2(-best.vPerp) : best.vPerp, tol);
+          if (b.kind == Border::Kind::Curved) {
+            singular[side] =
+                insertSingularInCurved(g, static_cast<int>(r), *l2, b, params, rng, drawIndex);
+            if (singular[side] < 0) break;
+          } else {
+            singular[side] = placeSingularOnBorder(g, *l2, b, params, rng, drawIndex);
+          }
+          ++stats.singularInserted;
+        }
+        if ((constrained(bwd) && singular[0] < 0) || (constrained(fwd) && singular[1] < 0)) {
+          why << "the strip meets a conical curved region";
+          stats.notes.push_back(why.str());
+          declined[r] = 1;
+          continue;
+        }
+        StripResult result;
+        if (singular[0] >= 0 && singular[1] >= 0) {
+          result.done = splitAlongCrease(g, static_cast<int>(r), singular[0], singular[1]);
+          if (result.done) ++stats.creases;
+        } else {
+          Pencil pencil;
+          if (singular[0] >= 0 || singular[1] >= 0) {
+            pencil.apex = singular[0] >= 0 ? singular[0] : singular[1];
+            const Vec2 s = g.vertices[static_cast<std::size_t>(pencil.apex)].pattern;
+            pencil.origin = s;
+            pencil.dir = (centroid - s).normalized();
+          } else {
+            pencil.origin = centroid;
+            pencil.dir = best.vPerp;
+          }
+          result = remeshStrip(g, static_cast<int>(r), pencil, params, boundary);
+          if (result.done) ++stats.curvedCreated;
+        }
+        if (!result.done) {
+          // Undo the singular vertices placed for it too: a singular vertex
+          // without its cone would be damage without a cause.
+          why << (result.note.empty() ? std::string("the crease could not split the region")
+                                      : result.note);
+          rollback(why.str());
+          continue;
+        }
+        if (const std::string problem = validate(g); !problem.empty()) {
+          rollback(problem);
+          continue;
+        }
+        stats.cuts.push_back(centroid);
+        for (int sv : singular) {
+          if (sv >= 0 && static_cast<std::size_t>(sv) < g.vertices.size()) {
+            stats.cuts.push_back(g.vertices[static_cast<std::size_t>(sv)].pattern);
+          }
+        }
+        changed = true;
+      } catch (const std::exception& e) {
+        // CDT refusing a polygon, a degenerate placement...: undo, go on.
+        rollback(e.what());
         continue;
       }
-      if (const std::string problem = validate(g); !problem.empty()) {
-        rollback(problem);
-        continue;
-      }
-      changed = true;
     }
     if (!changed) break;
   }

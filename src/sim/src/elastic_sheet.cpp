@@ -53,7 +53,10 @@
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <mutex>
+#include <numeric>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -221,7 +224,8 @@ ElasticSheet::Impl::Impl(const mesh::SheetMesh& m, const Material& material, con
   if (!p.gravity.allFinite() || !(p.massDamping >= 0.0) || !(p.stiffnessDamping >= 0.0) ||
       !std::isfinite(p.massDamping) || !std::isfinite(p.stiffnessDamping) ||
       p.maxNewtonIterations < 1 || !(p.newtonTolerance > 0.0) || p.maxHalvings < 0 ||
-      !(p.membraneScale > 0.0) || !std::isfinite(p.membraneScale))
+      !(p.membraneScale > 0.0) || !std::isfinite(p.membraneScale) ||
+      !(p.minVertexMassFraction >= 0.0) || !(p.minVertexMassFraction <= 1.0))
     throw std::invalid_argument("ElasticSheet: invalid simulation parameters");
 
   moduli = membraneModuli(material);
@@ -245,6 +249,20 @@ ElasticSheet::Impl::Impl(const mesh::SheetMesh& m, const Material& material, con
     for (const std::size_t i : {i0, i1, i2}) {
       mass[i] += third;
       active[i] = 1;
+    }
+  }
+  // Mass floor (SimParams::minVertexMassFraction): a vertex of sliver
+  // triangles gets at least this fraction of the mean vertex mass.
+  if (p.minVertexMassFraction > 0.0 && vertexCount > 0) {
+    double total = 0.0;
+    std::size_t used = 0;
+    for (std::size_t i = 0; i < vertexCount; ++i) {
+      if (active[i]) total += mass[i], ++used;
+    }
+    const double floor =
+        used > 0 ? p.minVertexMassFraction * total / static_cast<double>(used) : 0.0;
+    for (std::size_t i = 0; i < vertexCount; ++i) {
+      if (active[i]) mass[i] = std::max(mass[i], floor);
     }
   }
 
@@ -532,6 +550,10 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
   };
 
   const double massDiag = 1.0 / (h * h) + alpha / h;
+  static const bool debugNewton = [] {
+    const char* e = std::getenv("CRUMPLE_DEBUG_NEWTON");
+    return e != nullptr && e[0] == '1';
+  }();
   const double tol = params.newtonTolerance * typicalEdge;
   VecX gradQ(n), gradV(n), grad(n), dx(n);
   std::vector<Vec3> disp(nv);
@@ -661,6 +683,20 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
     if (!accepted) {
       why = "line search found no decrease";
       return false;
+    }
+    if (debugNewton) {
+      std::size_t worst = 0;
+      double wn = -1.0;
+      for (std::size_t i = 0; i < nv; ++i) {
+        const int fi = freeIndex[i];
+        if (fi >= 0 && dx.segment<3>(3 * fi).norm() > wn) {
+          wn = dx.segment<3>(3 * fi).norm();
+          worst = i;
+        }
+      }
+      std::fprintf(
+          stderr, "[newton] h %.3g it %d step %.3e s %.3g worst v %zu mass %.3g (mean %.3g)\n", h,
+          it, stepNorm, s, worst, mass[worst], std::accumulate(mass.begin(), mass.end(), 0.0) / nv);
     }
     xk.swap(xTrial);
   }

@@ -49,9 +49,9 @@ class HandleRig {
   void pins(double t, std::vector<sim::Pin>& out) const;
   // The hybrid model rebuilds its simulation mesh S_P as the sheet crumples:
   // handle vertices keep their indices, tangent-plane vertices are chosen
-  // again on the new mesh, their offsets taken from the flat placement
-  // `rest` (pattern -> world at bind time) the handles were bound in.
-  void rebindTangents(const mesh::SheetMesh& sheet, const std::function<Vec3(const Vec2&)>& rest);
+  // again on the new mesh at time t, their offsets measured from where they
+  // are now in the node's frame at t, so the pins move on continuously.
+  void rebindTangents(const mesh::SheetMesh& sheet, double t);
   // Moves pinned vertices onto their targets (called once before simulation).
   void snap(double t, std::vector<Vec3>& positions) const;
 

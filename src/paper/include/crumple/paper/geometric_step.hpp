@@ -27,13 +27,14 @@ using BoundaryPosition = std::function<Vec3(double s)>;
 // What one geometric step did (counts), for logs, tests and the cache.
 struct GeometricStepStats {
   int edgeFlips = 0;
-  int flatSplits = 0;              // flat regions split along an edge above theta_0
-  int curvedCreated = 0;           // curved regions created from compressed flat regions
-  int singularInserted = 0;        // new singular vertices (paper Sec. 5.2)
-  int creases = 0;                 // degenerate curved regions between two singular vertices
-  int junctionMoves = 0;           // junction points moved (paper Sec. 6.1)
-  int curvedFlattened = 0;         // curved regions turned back into flat regions
-  double maxCompression = 0.0;     // largest triangle compression ratio seen in flat regions
+  int flatSplits = 0;           // flat regions split along an edge above theta_0
+  int curvedCreated = 0;        // curved regions created from compressed flat regions
+  int singularInserted = 0;     // new singular vertices (paper Sec. 5.2)
+  int creases = 0;              // degenerate curved regions between two singular vertices
+  int junctionMoves = 0;        // junction points moved (paper Sec. 6.1)
+  int curvedFlattened = 0;      // curved regions turned back into flat regions
+  double maxCompression = 0.0;  // largest triangle compression ratio seen in flat regions
+  std::vector<Vec2> cuts;       // pattern points where compression was treated (for the cooldown)
   std::vector<std::string> notes;  // remeshing that was attempted and declined, and why
 };
 

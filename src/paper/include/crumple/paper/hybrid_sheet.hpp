@@ -57,15 +57,17 @@ class HybridSheet {
   HybridStepStats advance(double t, double dt, int substeps, const sim::PinFunction& pins,
                           int frame);
 
-  // Called with the new S_P every time it is rebuilt, before the isometry
-  // step asks for pins again (the handle rig re-chooses its tangent-plane
-  // vertices there).
-  void setRebuildCallback(std::function<void(const mesh::SheetMesh&)> callback);
+  // Called with the new S_P and the time it is at, every time S_P is
+  // rebuilt, before pins are asked for again (the handle rig re-chooses its
+  // tangent-plane vertices there).
+  void setRebuildCallback(std::function<void(const mesh::SheetMesh&, double t)> callback);
 
   // Moves pinned vertices (S_G or S_P indices) to the given positions before
   // the first step (handles snapping onto their tracks) and re-interpolates
   // S_P from S_G.
   void placeVertices(const std::vector<sim::Pin>& pins);
+  // The time the sheet is at before the first step (s).
+  void setTime(double t);
 
   const GeometricMesh& geometric() const;  // S_G
   const PhysicalMesh& physical() const;    // S_P (the displayed mesh)

@@ -31,11 +31,15 @@ struct CrumpleParams {
   // (sim::SimParams::membraneScale): "stiffness only needs to be of medium
   // range" (paper Sec. 1), lengths are restored by the isometry step.
   double membraneScale = 0.01;
+  double minVertexMassFraction = 0.05;  // sim::SimParams::minVertexMassFraction for S_P
   // Steps a region waits after it was cut before its compression is treated
   // again: cutting a compressed region leaves equally compressed pieces
   // until the elastic steps have bent S_P along the new structure (Appendix
   // B: "let the physical simulation further deform this region").
   int remeshCooldown = 3;
+  // At most this many new singular vertices per step (the most compressed
+  // regions first): singular points appear "progressively" (paper Sec. 7.3).
+  int maxSingularPerStep = 2;
 #ifdef NDEBUG
   bool checkInvariants = false;  // validate S_G and S_P after every geometric step
 #else

@@ -29,6 +29,11 @@ struct SimParams {
   // needs stiffness of medium range" since lengths are restored geometrically
   // (paper Sec. 1 and Sec. 6.3).
   double membraneScale = 1.0;
+  // Every vertex weighs at least this fraction of the mean vertex mass (0 =
+  // the lumped masses as they are). The hybrid model's remeshing can leave
+  // sliver triangles whose vertices would weigh ~1e-4 of the others and stall
+  // Newton's convergence; the floor adds a negligible mass there.
+  double minVertexMassFraction = 0.0;
 };
 
 // A hard constraint: vertex `vertex` sits at `position`.
