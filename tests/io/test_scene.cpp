@@ -2,10 +2,13 @@
 // line, key) for every bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
+#include <vector>
 
 #include "crumple/core/error.hpp"
 #include "crumple/io/animation.hpp"
@@ -438,6 +441,139 @@ TEST(SceneErrors, Sim) {
               {"[1, 1000]"});
 }
 
+// ---- [model] -----------------------------------------------------------------
+
+TEST(SceneModel, ElasticWhenAbsent) {
+  const SceneSpec s = parse(kSheet);
+  EXPECT_EQ(s.model.type, ModelSpec::Type::Elastic);
+  EXPECT_EQ(s.model.typeLine, 0);
+  const SceneSpec e = parse(kSheet + "[model]\ntype = \"elastic\"\n");
+  EXPECT_EQ(e.model.type, ModelSpec::Type::Elastic);
+  EXPECT_EQ(e.model.typeLine, 5);
+  EXPECT_EQ(parse(kSheet + "[model]\n").model.type, ModelSpec::Type::Elastic);
+}
+
+TEST(SceneModel, HybridDefaultsAreTheSeeds) {
+  // Paper Table VI, thesis 2.3.3; the same numbers as crumple::paper::CrumpleParams.
+  const SceneSpec s = parse(kSheet + "[model]\ntype = \"hybrid\"\n");
+  EXPECT_EQ(s.model.type, ModelSpec::Type::Hybrid);
+  EXPECT_EQ(s.model.typeLine, 5);
+  const HybridSpec& h = s.model.hybrid;
+  EXPECT_DOUBLE_EQ(h.rhoBound, 120.0);  // 1.2 per cm
+  EXPECT_DOUBLE_EQ(h.rhoInt, 3600.0);   // 0.36 per cm^2
+  EXPECT_DOUBLE_EQ(h.theta0, 0.01);
+  EXPECT_DOUBLE_EQ(h.thetaLow, 0.001);
+  EXPECT_DOUBLE_EQ(h.thetaHigh, 0.01);
+  EXPECT_DOUBLE_EQ(h.epsBlaschke, 0.005);
+  EXPECT_DOUBLE_EQ(h.epsC, 0.001);
+  EXPECT_DOUBLE_EQ(h.sigma, 0.001);  // 0.1 cm
+  EXPECT_DOUBLE_EQ(h.thetaRest, kPi / 8.0);
+  EXPECT_DOUBLE_EQ(h.damage, 10.0);
+  EXPECT_EQ(h.isometryIterations, 200);
+  // A scene without [model] carries the same defaults.
+  const HybridSpec d = parse(kSheet).model.hybrid;
+  EXPECT_DOUBLE_EQ(d.rhoBound, h.rhoBound);
+  EXPECT_DOUBLE_EQ(d.thetaRest, h.thetaRest);
+}
+
+TEST(SceneModel, EveryKeyParsedAndConvertedToSI) {
+  // units = "mm" must not scale the [model] parameters: their units are fixed.
+  const SceneSpec s = parse(
+      "[scene]\nunits = \"mm\"\n[sheet]\nwidth = 100\nheight = 100\n"
+      "[model]\n"
+      "type = \"hybrid\"\n"
+      "rho_bound_per_cm = 2.5\n"
+      "rho_int_per_cm2 = 6\n"
+      "theta0 = 0.02\n"
+      "theta_low = 0.003\n"
+      "theta_high = 0.015\n"
+      "eps_blaschke = 0.01\n"
+      "eps_c = 0.005\n"
+      "sigma_cm = 0.01\n"
+      "theta_rest = 0.5\n"
+      "damage = 4\n"
+      "isometry_iterations = 50\n");
+  const HybridSpec& h = s.model.hybrid;
+  EXPECT_EQ(s.model.type, ModelSpec::Type::Hybrid);
+  EXPECT_DOUBLE_EQ(h.rhoBound, 250.0);
+  EXPECT_DOUBLE_EQ(h.rhoInt, 60000.0);
+  EXPECT_DOUBLE_EQ(h.theta0, 0.02);
+  EXPECT_DOUBLE_EQ(h.thetaLow, 0.003);
+  EXPECT_DOUBLE_EQ(h.thetaHigh, 0.015);
+  EXPECT_DOUBLE_EQ(h.epsBlaschke, 0.01);
+  EXPECT_DOUBLE_EQ(h.epsC, 0.005);
+  EXPECT_DOUBLE_EQ(h.sigma, 0.0001);
+  EXPECT_DOUBLE_EQ(h.thetaRest, 0.5);
+  EXPECT_DOUBLE_EQ(h.damage, 4.0);
+  EXPECT_EQ(h.isometryIterations, 50);
+}
+
+TEST(SceneModel, HysteresisFollowsTheta0) {
+  const std::string head = kSheet + "[model]\ntype = \"hybrid\"\n";
+  const HybridSpec a = parse(head + "theta0 = 0.05\n").model.hybrid;
+  EXPECT_DOUBLE_EQ(a.thetaLow, 0.005);
+  EXPECT_DOUBLE_EQ(a.thetaHigh, 0.05);
+  const HybridSpec b = parse(head + "theta0 = 0.05\ntheta_low = 0.02\n").model.hybrid;
+  EXPECT_DOUBLE_EQ(b.thetaLow, 0.02);
+  EXPECT_DOUBLE_EQ(b.thetaHigh, 0.05);
+  const HybridSpec c = parse(head + "theta_high = 0.1\n").model.hybrid;
+  EXPECT_DOUBLE_EQ(c.thetaLow, 0.001);
+  EXPECT_DOUBLE_EQ(c.thetaHigh, 0.1);
+  const HybridSpec d = parse(head + "theta_rest = 0\ndamage = 0\n").model.hybrid;  // no damage
+  EXPECT_DOUBLE_EQ(d.thetaRest, 0.0);
+  EXPECT_DOUBLE_EQ(d.damage, 0.0);
+}
+
+TEST(SceneErrors, Model) {
+  const std::string head = kSheet + "[model]\ntype = \"hybrid\"\n";  // lines 1-5
+  expectError(kSheet + "[model]\ntype = \"fem\"\n", 5, "model.type",
+              {"unknown model 'fem'", "elastic, hybrid"});
+  expectError(kSheet + "[model]\ntype = 1\n", 5, "model.type", {"expected a string"});
+  expectError(kSheet + "[model]\ntype = \"elastic\"\neps_c = 0.01\n", 6, "model.eps_c",
+              {"only for type = \"hybrid\""});
+  expectError(kSheet + "[model]\nsigma_cm = 0.01\n", 5, "model.sigma_cm",
+              {"only for type = \"hybrid\""});  // type defaults to elastic
+  expectError(head + "rho_bound = 1.2\n", 6, "model.rho_bound",
+              {"unknown key", "rho_bound_per_cm"});
+  expectError(kSheet + "model = \"hybrid\"\n", 4, "sheet.model", {"unknown key"});
+  expectError("model = \"hybrid\"\n" + kSheet, 1, "model", {"expected a table"});
+
+  expectError(head + "rho_bound_per_cm = 0\n", 6, "model.rho_bound_per_cm", {"(0, 100)", "got 0"});
+  expectError(head + "rho_bound_per_cm = 120\n", 6, "model.rho_bound_per_cm", {"(0, 100)"});
+  expectError(head + "rho_bound_per_cm = \"1.2\"\n", 6, "model.rho_bound_per_cm",
+              {"expected a number"});
+  expectError(head + "rho_int_per_cm2 = -6\n", 6, "model.rho_int_per_cm2", {"(0, 10000)"});
+  expectError(head + "rho_int_per_cm2 = nan\n", 6, "model.rho_int_per_cm2", {"finite"});
+  expectError(head + "theta0 = 0\n", 6, "model.theta0", {"(0, pi/2)"});
+  expectError(head + "theta0 = 2\n", 6, "model.theta0", {"(0, pi/2)"});
+  expectError(head + "theta_low = -0.001\n", 6, "model.theta_low", {"(0, pi/2)"});
+  expectError(head + "theta_high = 3\n", 6, "model.theta_high", {"(0, pi/2)"});
+  expectError(head + "theta_low = 0.02\n", 6, "model.theta_low",
+              {"theta_low must be < theta_high", "0.02", "0.01"});
+  expectError(head + "theta_low = 0.005\ntheta_high = 0.005\n", 6, "model.theta_low",
+              {"theta_low must be < theta_high"});
+  expectError(head + "theta_high = 0.0005\n", 6, "model.theta_high",
+              {"theta_low must be < theta_high"});
+  expectError(head + "theta0 = 0.1\ntheta_low = 0.2\n", 7, "model.theta_low",
+              {"theta_low must be < theta_high"});
+  expectError(head + "eps_blaschke = 0\n", 6, "model.eps_blaschke", {"(0, 1)"});
+  expectError(head + "eps_blaschke = 5\n", 6, "model.eps_blaschke", {"(0, 1)", "got 5"});
+  expectError(head + "eps_c = 0\n", 6, "model.eps_c", {"(0, 0.5)"});
+  expectError(head + "eps_c = 0.5\n", 6, "model.eps_c", {"(0, 0.5)"});
+  expectError(head + "eps_c = 1\n", 6, "model.eps_c", {"(0, 0.5)", "got 1"});  // 1 % = 0.01
+  expectError(head + "eps_c = -0.001\n", 6, "model.eps_c", {"(0, 0.5)"});
+  expectError(head + "sigma_cm = 0\n", 6, "model.sigma_cm", {"(0, 100)"});
+  expectError(head + "sigma_cm = inf\n", 6, "model.sigma_cm", {"finite"});
+  expectError(head + "theta_rest = -0.1\n", 6, "model.theta_rest", {"[0, pi)"});
+  expectError(head + "theta_rest = 3.2\n", 6, "model.theta_rest", {"[0, pi)"});
+  expectError(head + "damage = -1\n", 6, "model.damage", {">= 0"});
+  expectError(head + "isometry_iterations = 0\n", 6, "model.isometry_iterations", {"[1, 100000]"});
+  expectError(head + "isometry_iterations = 200000\n", 6, "model.isometry_iterations",
+              {"[1, 100000]"});
+  expectError(head + "isometry_iterations = 20.5\n", 6, "model.isometry_iterations",
+              {"expected an integer"});
+}
+
 TEST(SceneAnimation, NodesAreCheckedAgainstTheFile) {
   const std::string good = R"([scene]
 animation = "anim.glb"
@@ -477,6 +613,70 @@ node = "Child"
   text = good;
   expectCheckError(text.replace(text.find("\"Sheet\""), 7, "\"Handle\""),
                    "test.toml:4: 'sheet.pattern_mesh': ", "holds no triangle mesh");
+}
+
+// ---- The shipped samples ---------------------------------------------------------
+
+// Every scene file in samples/*/ (a folder may hold several, e.g. paper-types).
+std::vector<std::filesystem::path> sampleScenes() {
+  namespace fs = std::filesystem;
+  const fs::path samples = (fs::path(kData) / ".." / ".." / ".." / "samples").lexically_normal();
+  std::vector<fs::path> scenes;
+  for (const auto& dir : fs::directory_iterator(samples)) {
+    if (!dir.is_directory()) continue;
+    for (const auto& f : fs::directory_iterator(dir.path()))
+      if (f.is_regular_file() && f.path().extension() == ".toml") scenes.push_back(f.path());
+  }
+  std::sort(scenes.begin(), scenes.end());
+  return scenes;
+}
+
+TEST(Samples, EverySceneParsesAndMatchesItsAnimation) {
+  const auto scenes = sampleScenes();
+  ASSERT_GE(scenes.size(), 9u);  // drape, the six seeds' experiments, variants
+  RecordProperty("scenes", static_cast<int>(scenes.size()));
+  std::set<std::string> names;
+  for (const auto& path : scenes) {
+    SCOPED_TRACE(path.string());
+    SceneSpec s;
+    ASSERT_NO_THROW(s = loadScene(path.string()));  // animation file checked to exist
+    EXPECT_TRUE(names.insert(s.name).second) << "two samples write to out/" << s.name;
+    ASSERT_FALSE(s.animationFile.empty());
+    AnimationScene anim = AnimationScene::load(s.animationFile);
+    EXPECT_TRUE(anim.warnings().empty());
+    ASSERT_NO_THROW(checkAnimationNodes(s, anim));
+    ASSERT_FALSE(s.handles.empty());
+    // Each handle's node starts on the sheet point it holds: the generator
+    // scripts and the scene files agree on where the sheet is.
+    const double t0 = s.frameTime(s.frameStart);
+    for (const HandleSpec& h : s.handles) {
+      ASSERT_EQ(s.sheet.kind, SheetSpec::Kind::Rectangle);
+      ASSERT_TRUE(h.patternPoint.has_value()) << h.name;
+      const Vec3 held = s.sheet.origin + h.patternPoint->x() * s.sheet.uAxis +
+                        h.patternPoint->y() * s.sheet.vAxis;
+      EXPECT_LT((anim.worldPose(h.node, t0).position - held).norm(), 1e-6) << h.name;
+      if (h.releaseTime) {
+        EXPECT_LT(*h.releaseTime, s.frameTime(s.frameEnd)) << h.name;
+      }
+    }
+    // The shot covers the whole animation.
+    EXPECT_GE(s.frameTime(s.frameEnd) + 1e-6, anim.endTime());
+  }
+}
+
+TEST(Samples, PaperTypesDifferOnlyInEpsC) {
+  const std::string dir = kData + "/../../../samples/paper-types/";
+  const SceneSpec a = loadScene(dir + "eps-1.0.toml");
+  const SceneSpec b = loadScene(dir + "eps-0.5.toml");
+  const SceneSpec c = loadScene(dir + "eps-0.2.toml");
+  EXPECT_EQ(a.model.type, ModelSpec::Type::Hybrid);
+  EXPECT_DOUBLE_EQ(a.model.hybrid.epsC, 0.01);
+  EXPECT_DOUBLE_EQ(b.model.hybrid.epsC, 0.005);
+  EXPECT_DOUBLE_EQ(c.model.hybrid.epsC, 0.002);
+  EXPECT_EQ(a.animationFile, b.animationFile);
+  EXPECT_EQ(a.animationFile, c.animationFile);
+  EXPECT_EQ(a.handles.size(), c.handles.size());
+  EXPECT_DOUBLE_EQ(a.model.hybrid.sigma, c.model.hybrid.sigma);
 }
 
 }  // namespace

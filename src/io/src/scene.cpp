@@ -22,6 +22,12 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxSubsteps = 1024;
 constexpr std::int64_t kMaxResolution = 16384;
+// Upper limits of the hybrid parameters: far beyond any useful value, they
+// catch numbers written in another unit (per m instead of per cm, ...).
+constexpr double kMaxRhoBoundPerCm = 100.0;   // 0.1 mm between boundary samples
+constexpr double kMaxRhoIntPerCm2 = 10000.0;  // 0.1 mm between interior samples
+constexpr double kMaxSigmaCm = 100.0;
+constexpr std::int64_t kMaxIsometryIterations = 100000;
 
 class SceneParser {
  public:
@@ -38,8 +44,8 @@ class SceneParser {
 
   SceneSpec parse() {
     const TableReader root(root_, "", file_);
-    root.allowOnly(
-        {"scene", "sheet", "paper", "handles", "camera", "lights", "ground", "output", "sim"});
+    root.allowOnly({"scene", "sheet", "paper", "handles", "camera", "lights", "ground", "output",
+                    "sim", "model"});
     // [scene] first: its `units` scales every length that follows.
     parseScene(root.subTable("scene"));
     const toml::table* sheet = root.subTable("sheet");
@@ -52,6 +58,7 @@ class SceneParser {
     parseGround(root.subTable("ground"));
     parseOutput(root.subTable("output"));
     parseSim(root.subTable("sim"));
+    parseModel(root.subTable("model"));
     return std::move(spec_);
   }
 
@@ -416,6 +423,98 @@ class SceneParser {
         r.fail("max_newton_iterations", "must be in [1, 1000] (got " + std::to_string(*n) + ")");
       }
       s.maxNewtonIterations = static_cast<int>(*n);
+    }
+  }
+
+  // [model]: which sheet model runs, and the hybrid model's parameters (paper
+  // Table VI). The parameters have fixed units (their names say which),
+  // whatever [scene] units says.
+  void parseModel(const toml::table* table) {
+    if (!table) return;
+    const TableReader r(*table, "model", file_);
+    static constexpr std::string_view kHybridKeys[] = {
+        "rho_bound_per_cm",   "rho_int_per_cm2", "theta0",   "theta_low",  "theta_high",
+        "eps_blaschke",       "eps_c",           "sigma_cm", "theta_rest", "damage",
+        "isometry_iterations"};
+    r.allowOnly({"type", "rho_bound_per_cm", "rho_int_per_cm2", "theta0", "theta_low", "theta_high",
+                 "eps_blaschke", "eps_c", "sigma_cm", "theta_rest", "damage",
+                 "isometry_iterations"});
+    ModelSpec& m = spec_.model;
+    m.typeLine = r.lineOf("type");
+    const std::string type = r.string("type").value_or("elastic");
+    if (type == "elastic") {
+      m.type = ModelSpec::Type::Elastic;
+      // A hybrid parameter under the elastic model is a mistake, not a no-op:
+      // report the first one in file order.
+      std::string_view first;
+      long firstLine = 0;
+      for (std::string_view key : kHybridKeys) {
+        if (r.has(key) && (first.empty() || r.lineOf(key) < firstLine)) {
+          first = key;
+          firstLine = r.lineOf(key);
+        }
+      }
+      if (!first.empty()) {
+        r.fail(first, "only for type = \"hybrid\" (the elastic model has no such parameter)");
+      }
+      return;
+    }
+    if (type != "hybrid") {
+      r.fail("type", "unknown model '" + type + "' (expected one of: elastic, hybrid)");
+    }
+    m.type = ModelSpec::Type::Hybrid;
+    HybridSpec& h = m.hybrid;
+    // value in (lo, hi), or [lo, hi) when loClosed; hiText names hi in the message.
+    auto inRange = [&](std::string_view key, double v, double lo, double hi, bool loClosed,
+                       const std::string& hiText = {}) {
+      if (!((loClosed ? v >= lo : v > lo) && v < hi)) {
+        r.fail(key, "must be in " + std::string(loClosed ? "[" : "(") + formatNumber(lo) + ", " +
+                        (hiText.empty() ? formatNumber(hi) : hiText) + ") (got " + formatNumber(v) +
+                        ")");
+      }
+      return v;
+    };
+    constexpr double kHalfPi = kPi / 2.0;
+    const std::string halfPi = "pi/2";
+    if (auto v = r.number("rho_bound_per_cm")) {
+      h.rhoBound = inRange("rho_bound_per_cm", *v, 0.0, kMaxRhoBoundPerCm, false) * 100.0;
+    }
+    if (auto v = r.number("rho_int_per_cm2")) {
+      h.rhoInt = inRange("rho_int_per_cm2", *v, 0.0, kMaxRhoIntPerCm2, false) * 1.0e4;
+    }
+    if (auto v = r.number("theta0")) {
+      h.theta0 = inRange("theta0", *v, 0.0, kHalfPi, false, halfPi);
+      // The hysteresis thresholds follow theta0 unless given (Table VI).
+      h.thetaLow = h.theta0 / 10.0;
+      h.thetaHigh = h.theta0;
+    }
+    if (auto v = r.number("theta_low")) {
+      h.thetaLow = inRange("theta_low", *v, 0.0, kHalfPi, false, halfPi);
+    }
+    if (auto v = r.number("theta_high")) {
+      h.thetaHigh = inRange("theta_high", *v, 0.0, kHalfPi, false, halfPi);
+    }
+    if (!(h.thetaLow < h.thetaHigh)) {
+      const char* key = r.has("theta_low") ? "theta_low" : "theta_high";
+      r.fail(key, "theta_low must be < theta_high (got theta_low = " + formatNumber(h.thetaLow) +
+                      ", theta_high = " + formatNumber(h.thetaHigh) + ")");
+    }
+    if (auto v = r.number("eps_blaschke")) {
+      h.epsBlaschke = inRange("eps_blaschke", *v, 0.0, 1.0, false);
+    }
+    if (auto v = r.number("eps_c")) h.epsC = inRange("eps_c", *v, 0.0, 0.5, false);
+    if (auto v = r.number("sigma_cm")) {
+      h.sigma = inRange("sigma_cm", *v, 0.0, kMaxSigmaCm, false) * 0.01;
+    }
+    if (auto v = r.number("theta_rest"))
+      h.thetaRest = inRange("theta_rest", *v, 0.0, kPi, true, "pi");
+    if (auto v = r.number("damage")) h.damage = r.requireNonNegative("damage", *v);
+    if (auto n = r.integer("isometry_iterations")) {
+      if (*n < 1 || *n > kMaxIsometryIterations) {
+        r.fail("isometry_iterations", "must be in [1, " + std::to_string(kMaxIsometryIterations) +
+                                          "] (got " + std::to_string(*n) + ")");
+      }
+      h.isometryIterations = static_cast<int>(*n);
     }
   }
 

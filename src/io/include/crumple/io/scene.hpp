@@ -99,6 +99,33 @@ struct SimSpec {
   int maxNewtonIterations = 30;
 };
 
+// Parameters of the hybrid crumpling model (paper Table VI; thesis 2.3.3),
+// in SI units. The defaults equal crumple::paper::CrumpleParams
+// (src/paper/include/crumple/paper/params.hpp); io does not depend on
+// src/paper, so the pipeline copies these fields over.
+struct HybridSpec {
+  double rhoBound = 120.0;     // boundary samples per m (1.2 per cm)
+  double rhoInt = 3600.0;      // interior samples per m^2 (0.36 per cm^2, see params.hpp)
+  double theta0 = 0.01;        // rad, coplanarity threshold
+  double thetaLow = 0.001;     // rad, junction hysteresis (theta0 / 10)
+  double thetaHigh = 0.01;     // rad, junction hysteresis (theta0)
+  double epsBlaschke = 0.005;  // cone-fit tolerance, fraction of L_paper
+  double epsC = 0.001;         // compression threshold, fraction (0.1 %)
+  double sigma = 0.001;        // m, singular-vertex position spread (0.1 cm)
+  double thetaRest = 0.39269908169872414;  // rad, pi / 8 (thesis eq. 2.1)
+  double damage = 10.0;                    // fiber damage D (thesis eq. 2.2)
+  int isometryIterations = 200;            // Phase I iteration cap (paper Sec. 6.3)
+};
+
+struct ModelSpec {
+  // Elastic: plain FEM on the fixed [sheet] mesh. Hybrid: the crumpling model
+  // of Schreck et al. 2015 (flat/curved regions, singular vertices).
+  enum class Type { Elastic, Hybrid };
+  Type type = Type::Elastic;  // default when the scene has no [model] table
+  long typeLine = 0;          // scene file line of `type` (or [model]), 0 = absent (for errors)
+  HybridSpec hybrid;          // meaningful for Type::Hybrid only
+};
+
 struct SceneSpec {
   std::string file;           // scene.toml path as given
   std::string dir;            // folder holding it (relative paths resolve here)
@@ -119,6 +146,7 @@ struct SceneSpec {
   GroundSpec ground;
   OutputSpec output;
   SimSpec sim;
+  ModelSpec model;
   std::string sourceText;  // the scene file's text, kept for the cache header
 
   // Animation time (s) of frame `frame`: frame / fps, the DCC convention

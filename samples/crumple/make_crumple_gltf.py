@@ -1,0 +1,292 @@
+#!/usr/bin/env python3
+"""Writes samples/crumple/crumple.gltf: the handle curves of the crumple
+sample (paper Fig. 22, second row: "a full crumpling animation where more
+than twenty singular vertices are progressively generated"; Table V reports
+up to 15 interior singular vertices for it).
+
+glTF 2.0, Y-up, metres, seconds; keys every 1/48 s (every frame at 24 fps and
+every half frame), sampled from eased (C2 smootherstep) analytic motions.
+
+The sheet: 10 cm x 10 cm, flat at y = 10 cm, centred on the Y axis, pattern
+u along world +X, v along world -Z (front edge v = 0 at z = +5 cm). Eight
+handles, all with tangent-plane control, hold the corners and the edge
+midpoints (pattern point (u, v) in cm):
+
+    BackL (0,10)    MidB (5,10)    BackR (10,10)        z = -5 cm
+    MidL  (0,5)                    MidR  (10,5)
+    FrontL (0,0)    MidF (5,0)     FrontR (10,0)        z = +5 cm
+
+Each handle's position is (with c the sheet's centre and (x, z) its pattern
+offset from c)
+    c + Ry(yaw) (sx x, 0, sz z) + (0, lift, 0)
+and its rotation Ry(yaw) Rx(rx) Rz(rz) R(tilt), R(tilt) turning the handle's
+inward direction up (tilt > 0) or down (tilt < 0) about its border's axis
+(for a corner: the axis across its diagonal). sx, sz are shared by all
+handles, so horizontal distances only shrink; the three handles of a side
+turn together (rx, rz), so the side stays straight; lift, tilt and yaw are
+per handle (PLAN). Four overlapping phases compress the sheet from ever more
+sides, so singular points keep appearing:
+  A 0.25-1.75  left and right sides move in: sx 1 -> 0.7. Each side's three
+               handles turn 35 degrees about Z so that the sheet arches up
+               across X; MidF and MidB rise 1.5 cm (their borders arch too).
+  B 1.00-2.50  front and back sides move in: sz 1 -> 0.7. Each side's three
+               handles turn 35 degrees about X so that the sheet arches down
+               across Z; MidL and MidR sink 1 cm: a saddle, which no
+               developable surface makes smoothly.
+  C 2.00-3.50  the corners take over: FrontL and BackR rise 1.5 cm and fold
+               up 40 degrees, FrontR and BackL sink 0.5 cm and fold down 25
+               degrees; the corners yaw +15 degrees about the vertical, the
+               midpoints -5 degrees (a twist).
+  D 2.00-4.00  everything squeezes further in: sx, sz -> 0.45.
+  4.00-4.50    hold.
+check() asserts that no two held points (handle vertices and their tangent
+neighbours) ever get farther apart than on the pattern: the handles only
+ever compress the sheet, never stretch it. There are no contacts yet
+(README), so the sheet may pass through itself at the end.
+
+Run it to regenerate the file (the committed file is its output):
+    python3 samples/crumple/make_crumple_gltf.py [OUT.gltf]
+"""
+import base64
+import json
+import math
+import os
+import struct
+import sys
+
+# ---- geometry and timing (metres, seconds, radians) ----
+W = 0.10            # sheet side
+Y0 = 0.10           # height of the flat sheet
+T_A = (0.25, 1.75)
+T_B = (1.00, 2.50)
+T_C = (2.00, 3.50)
+T_D = (2.00, 4.00)
+T_END = 4.50
+KEYS_PER_SECOND = 48
+DEG = math.pi / 180.0
+
+# (node name, u, v) in metres on the pattern
+HANDLES = [("FrontL", 0.0, 0.0), ("MidF", W / 2, 0.0), ("FrontR", W, 0.0),
+           ("MidR", W, W / 2), ("BackR", W, W), ("MidB", W / 2, W),
+           ("BackL", 0.0, W), ("MidL", 0.0, W / 2)]
+
+# Per handle, per phase: what the handle has reached at the phase's end:
+#   lift  m, up;
+#   rx    rad, turn about world X (front/back side arches: the sheet's
+#         in-plane direction towards the middle goes up or down);
+#   rz    rad, turn about world Z (left/right side arches);
+#   tilt  rad, turn about the handle's own border axis (for a corner, the
+#         axis across its diagonal), inward direction up if > 0;
+#   yaw   rad, turn about the vertical (also turns the handle's offset from
+#         the centre: a twist).
+# A side's three handles turn together, so that the side stays straight.
+LEFT, RIGHT = ("FrontL", "MidL", "BackL"), ("FrontR", "MidR", "BackR")
+FRONT, BACK = ("FrontL", "MidF", "FrontR"), ("BackL", "MidB", "BackR")
+PLAN = {name: {} for name, _, _ in HANDLES}
+
+
+def plan(phase, names, **moves):
+    for name in names:
+        PLAN[name].setdefault(phase, {}).update(moves)
+
+
+ARCH = 35 * DEG
+plan("A", LEFT, rz=ARCH)                  # left and right sides: arch up across X
+plan("A", RIGHT, rz=-ARCH)
+plan("A", ("MidF", "MidB"), lift=0.015)   # the front and back borders arch up too
+plan("B", FRONT, rx=-ARCH)                # front and back sides: arch down across Z
+plan("B", BACK, rx=ARCH)
+plan("B", ("MidL", "MidR"), lift=-0.01)   # the left and right borders sink: a saddle
+plan("C", ("FrontL", "BackR"), lift=0.015, tilt=40 * DEG, yaw=15 * DEG)  # corners fold up
+plan("C", ("FrontR", "BackL"), lift=-0.005, tilt=-25 * DEG, yaw=15 * DEG)  # and down
+plan("C", ("MidF", "MidR", "MidB", "MidL"), yaw=-5 * DEG)  # against the corners' twist
+SPANS = {"A": T_A, "B": T_B, "C": T_C}
+
+
+# ---- small helpers (stdlib only) ----
+def smoother(x):
+    """C2 ease in/out on [0, 1] (smootherstep), clamped."""
+    x = min(1.0, max(0.0, x))
+    return x * x * x * (x * (6.0 * x - 15.0) + 10.0)
+
+
+def ramp(t, span):
+    return smoother((t - span[0]) / (span[1] - span[0]))
+
+
+def qaxis(axis, angle):
+    """Quaternion (x, y, z, w), glTF order, rotating by angle about axis."""
+    n = math.sqrt(sum(c * c for c in axis))
+    s = math.sin(angle / 2.0) / n
+    return (axis[0] * s, axis[1] * s, axis[2] * s, math.cos(angle / 2.0))
+
+
+def qmul(a, b):
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return (aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+            aw * bw - ax * bx - ay * by - az * bz)
+
+
+def cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def qrot(q, v):
+    qv, w = q[:3], q[3]
+    c1 = cross(qv, v)
+    c2 = cross(qv, c1)
+    return tuple(v[i] + 2.0 * w * c1[i] + 2.0 * c2[i] for i in range(3))
+
+
+def write_gltf(path, generator, times, tracks, camera=None):
+    """tracks: [(node name, [position], [rotation quaternion] or None)].
+    camera: None or (node name, yfov rad, aspect): that track's node holds a
+    perspective camera (looking down its local -Z, +Y up)."""
+    blob = bytearray()
+    views, accessors = [], []
+
+    def add(values, count, type_, minmax=None):
+        offset = len(blob)
+        blob.extend(struct.pack("<%df" % len(values), *values))
+        views.append({"buffer": 0, "byteOffset": offset, "byteLength": 4 * len(values)})
+        acc = {"bufferView": len(views) - 1, "componentType": 5126, "count": count, "type": type_}
+        if minmax:
+            acc["min"], acc["max"] = minmax
+        accessors.append(acc)
+        return len(accessors) - 1
+
+    t_acc = add(times, len(times), "SCALAR", ([min(times)], [max(times)]))
+    nodes, samplers, channels = [], [], []
+    for index, (name, positions, rotations) in enumerate(tracks):
+        node = {"name": name, "translation": list(positions[0])}
+        if camera is not None and camera[0] == name:
+            node["camera"] = 0
+        samplers.append({"input": t_acc, "interpolation": "LINEAR",
+                         "output": add([c for p in positions for c in p], len(positions), "VEC3")})
+        channels.append({"sampler": len(samplers) - 1,
+                         "target": {"node": index, "path": "translation"}})
+        if rotations is not None:
+            # Keep consecutive keys in one hemisphere (slerp along the short arc).
+            rots = [rotations[0]]
+            for q in rotations[1:]:
+                rots.append(q if sum(a * b for a, b in zip(q, rots[-1])) >= 0.0
+                            else tuple(-c for c in q))
+            node["rotation"] = list(rots[0])
+            samplers.append({"input": t_acc, "interpolation": "LINEAR",
+                             "output": add([c for q in rots for c in q], len(rots), "VEC4")})
+            channels.append({"sampler": len(samplers) - 1,
+                             "target": {"node": index, "path": "rotation"}})
+        nodes.append(node)
+    gltf = {
+        "asset": {"version": "2.0", "generator": generator},
+        "scene": 0,
+        "scenes": [{"nodes": list(range(len(nodes)))}],
+        "nodes": nodes,
+        "animations": [{"name": "handles", "samplers": samplers, "channels": channels}],
+        **({"cameras": [{"type": "perspective", "perspective": {
+            "yfov": camera[1], "aspectRatio": camera[2], "znear": 0.01, "zfar": 100.0}}]}
+           if camera is not None else {}),
+        "buffers": [{
+            "byteLength": len(blob),
+            "uri": "data:application/octet-stream;base64," + base64.b64encode(bytes(blob)).decode(),
+        }],
+        "bufferViews": views,
+        "accessors": accessors,
+    }
+    with open(path, "w") as f:
+        json.dump(gltf, f, indent=1)
+        f.write("\n")
+
+
+def check_no_stretch(times, tracks_, pattern, size, axes, patch=0.01):
+    """Asserts that the handles never pull the sheet longer than its pattern:
+    no two held points get farther apart than on the pattern. Held points are
+    each handle's vertex and, for tangent-plane control, its neighbours, taken
+    here `patch` metres away along the pattern axes (1 cm: coarser than any
+    mesh the samples run on), carried rigidly by the node's rotation.
+    pattern: {node: (u, v)} in metres; size: (width, height); axes: the world
+    directions of the pattern's u and v at the first frame (every node starts
+    with the identity rotation). Returns the worst ratio."""
+    (ux, uy, uz), (vx, vy, vz) = axes
+    held = []  # (node, u, v, local offset at bind)
+    for name, (u, v) in pattern.items():
+        held.append((name, u, v, (0.0, 0.0, 0.0)))
+        for du, dv in ((patch, 0.0), (-patch, 0.0), (0.0, patch), (0.0, -patch)):
+            if -1e-9 <= u + du <= size[0] + 1e-9 and -1e-9 <= v + dv <= size[1] + 1e-9:
+                held.append((name, u + du, v + dv,
+                             (du * ux + dv * vx, du * uy + dv * vy, du * uz + dv * vz)))
+    index = {name: i for i, (name, _, _) in enumerate(tracks_)}
+    worst = 0.0
+    for k, _ in enumerate(times):
+        world = []
+        for name, u, v, offset in held:
+            _, positions, rotations = tracks_[index[name]]
+            o = qrot(rotations[k], offset) if rotations is not None else offset
+            world.append(tuple(p + c for p, c in zip(positions[k], o)))
+        for i in range(len(held)):
+            for j in range(i + 1, len(held)):
+                if held[i][0] == held[j][0]:
+                    continue
+                d0 = math.hypot(held[i][1] - held[j][1], held[i][2] - held[j][2])
+                worst = max(worst, math.dist(world[i], world[j]) / d0)
+    assert worst <= 1.0 + 1e-9, "the handles stretch the sheet by %.3g %%" % (100 * (worst - 1))
+    return worst
+
+
+# ---- the motion ----
+def scales(t):
+    a, b, d = ramp(t, T_A), ramp(t, T_B), ramp(t, T_D)
+    sx = 1.0 - 0.30 * a - 0.25 * d
+    sz = 1.0 - 0.30 * b - 0.25 * d
+    return sx, sz
+
+
+def handle_pose(name, u, v, t):
+    """World position and rotation of handle `name` at pattern point (u, v)."""
+    x, z = u - W / 2.0, W / 2.0 - v
+    total = {"lift": 0.0, "rx": 0.0, "rz": 0.0, "tilt": 0.0, "yaw": 0.0}
+    for phase, moves in PLAN[name].items():
+        e = ramp(t, SPANS[phase])
+        for key, value in moves.items():
+            total[key] += value * e
+    sx, sz = scales(t)
+    q_yaw = qaxis((0.0, 1.0, 0.0), total["yaw"])
+    p = qrot(q_yaw, (sx * x, 0.0, sz * z))
+    # Tilt about the border's axis: cross(inward, up) turns `inward` upwards.
+    n = math.hypot(x, z)
+    inward = (-x / n, 0.0, -z / n)
+    axis = cross(inward, (0.0, 1.0, 0.0))
+    q = qmul(q_yaw, qmul(qaxis((1.0, 0.0, 0.0), total["rx"]),
+                         qmul(qaxis((0.0, 0.0, 1.0), total["rz"]), qaxis(axis, total["tilt"]))))
+    return (p[0], Y0 + total["lift"] + p[1], p[2]), q
+
+
+def tracks():
+    times = [k / KEYS_PER_SECOND for k in range(int(round(T_END * KEYS_PER_SECOND)) + 1)]
+    out = []
+    for name, u, v in HANDLES:
+        poses = [handle_pose(name, u, v, t) for t in times]
+        out.append((name, [p for p, _ in poses], [q for _, q in poses]))
+    return times, out
+
+
+def check(times, tracks_):
+    """No two held points ever get farther apart than on the pattern."""
+    pattern = {name: (u, v) for name, u, v in HANDLES}
+    return check_no_stretch(times, tracks_, pattern, (W, W),
+                            ((1.0, 0.0, 0.0), (0.0, 0.0, -1.0)))
+
+
+def main():
+    here = os.path.dirname(os.path.abspath(__file__))
+    path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "crumple.gltf")
+    times, tr = tracks()
+    check(times, tr)
+    write_gltf(path, "crumple samples/crumple/make_crumple_gltf.py", times, tr)
+
+
+if __name__ == "__main__":
+    main()
