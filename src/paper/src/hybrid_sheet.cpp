@@ -298,7 +298,9 @@ HybridStepStats HybridSheet::advance(double t, double dt, int substeps,
     if (!m.isometry || !m.isometry->sameTopology(m.sp.mesh.triangles, fixed) ||
         static_cast<std::size_t>(m.isometry->vertexCount()) != m.sp.mesh.vertexCount() ||
         stats.topologyChanged) {
-      m.isometry.emplace(m.sp.mesh.pattern, m.sp.mesh.triangles, fixed);
+      IsometryOptions iso;
+      iso.rounds = m.params.isometryRounds;
+      m.isometry.emplace(m.sp.mesh.pattern, m.sp.mesh.triangles, fixed, iso);
     }
     std::vector<Vec3> positions = m.sp.mesh.positions;
     stats.isometry = m.isometry->project(positions, m.params.isometryIterations);

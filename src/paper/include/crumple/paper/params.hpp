@@ -27,6 +27,7 @@ struct CrumpleParams {
   double thetaRest = std::numbers::pi / 8.0;  // fiber damage rest angle (thesis eq. 2.1)
   double damage = 10.0;                       // fiber damage D (thesis eq. 2.2)
   int isometryIterations = 200;               // Phase I iteration cap (paper Sec. 6.3)
+  int isometryRounds = 1;  // Phase I + II passes per step (IsometryOptions::rounds)
   // Membrane stiffness of the coarse FEM on S_P as a fraction of the paper's
   // (sim::SimParams::membraneScale): "stiffness only needs to be of medium
   // range" (paper Sec. 1), lengths are restored by the isometry step.
