@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -427,41 +426,4 @@ TEST(Isometry, Deterministic) {
   EXPECT_FALSE(bitwiseEqual(a, r.noisy));
   EXPECT_EQ(sa.meanLengthErrorAfter, sb.meanLengthErrorAfter);
   EXPECT_EQ(sa.meanDisplacement, sb.meanDisplacement);
-}
-
-// Measurement only (no time assertion): median time per call and the figures
-// for ~120 and ~400 triangle sheets, recorded in the gtest XML report.
-TEST(Isometry, MeasureTimePerCall) {
-  struct Case {
-    const char* name;
-    double height, maxEdge;
-  };
-  for (const Case& c : {Case{"t120", 0.075, kWidth / 6.0}, Case{"t400", 0.10, 0.01}}) {
-    const NoisyRoll r = makeNoisyRoll(c.height, c.maxEdge, 5);
-    IsometryProjector projector(r.grid.sheet.pattern, r.grid.sheet.triangles,
-                                {r.grid.cornerA(), r.grid.cornerB()});
-    std::vector<double> ms;
-    IsometryStats s;
-    for (int k = 0; k < 15; ++k) {
-      std::vector<Vec3> p = r.noisy;
-      const auto t0 = std::chrono::steady_clock::now();
-      s = projector.project(p);
-      const auto t1 = std::chrono::steady_clock::now();
-      ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
-    }
-    std::sort(ms.begin(), ms.end());
-    const double median = ms[ms.size() / 2];
-    std::printf(
-        "%zu triangles: %.3f ms per call (median of %zu), c_mean %.3e -> %.3e, %d iterations, "
-        "d_m %.3e m\n",
-        r.grid.sheet.triangles.size(), median, ms.size(), s.meanLengthErrorBefore,
-        s.meanLengthErrorAfter, s.phaseOneIterations, s.meanDisplacement);
-    const std::string n = c.name;
-    ::testing::Test::RecordProperty(n + "_triangles",
-                                    static_cast<int>(r.grid.sheet.triangles.size()));
-    ::testing::Test::RecordProperty(n + "_ms_median", sci(median));
-    ::testing::Test::RecordProperty(n + "_cmean_before", sci(s.meanLengthErrorBefore));
-    ::testing::Test::RecordProperty(n + "_cmean_after", sci(s.meanLengthErrorAfter));
-    EXPECT_LT(s.meanLengthErrorAfter, s.meanLengthErrorBefore);
-  }
 }

@@ -355,6 +355,71 @@ Border findBorder(const GeometricMesh& g, const Loop& loop, const Vec2& origin, 
   return border;
 }
 
+// A vertex at pattern point s inside the curved cell between rulings r0 and
+// r1: its 3D position and velocity by barycentric interpolation in the cell
+// triangle holding it (the cell split along its first diagonal). nullopt when
+// s lies in neither triangle.
+std::optional<GeometricVertex> vertexInCell(const GeometricMesh& g, const Ruling& r0,
+                                            const Ruling& r1, const Vec2& s) {
+  const auto P = [&](int v) -> const Vec2& {
+    return g.vertices[static_cast<std::size_t>(v)].pattern;
+  };
+  const std::array<int, 4> q{r0.a, r1.a, r1.b, r0.b};
+  for (const auto& tri :
+       {std::array<int, 3>{q[0], q[1], q[2]}, std::array<int, 3>{q[0], q[2], q[3]}}) {
+    const Vec2 p0 = P(tri[0]);
+    const double det = cross2(P(tri[1]) - p0, P(tri[2]) - p0);
+    if (std::abs(det) < 1e-30) continue;
+    const double l1 = cross2(s - p0, P(tri[2]) - p0) / det;
+    const double l2 = cross2(P(tri[1]) - p0, s - p0) / det;
+    const double l0 = 1.0 - l1 - l2;
+    if (l0 < -1e-9 || l1 < -1e-9 || l2 < -1e-9) continue;
+    const auto& V = g.vertices;
+    GeometricVertex v;
+    v.pattern = s;
+    v.position = l0 * V[static_cast<std::size_t>(tri[0])].position +
+                 l1 * V[static_cast<std::size_t>(tri[1])].position +
+                 l2 * V[static_cast<std::size_t>(tri[2])].position;
+    v.velocity = l0 * V[static_cast<std::size_t>(tri[0])].velocity +
+                 l1 * V[static_cast<std::size_t>(tri[1])].velocity +
+                 l2 * V[static_cast<std::size_t>(tri[2])].velocity;
+    return v;
+  }
+  return std::nullopt;
+}
+
+// paper Fig. 11: the cells of a curved region between its rulings lo and hi
+// become two fans of rulings from the singular vertex s (one per boundary
+// chain), each a cone region with apex s.
+void addConeFans(GeometricMesh& g, int s, const std::vector<Ruling>& rulings, std::size_t lo,
+                 std::size_t hi) {
+  for (int chain = 0; chain < 2; ++chain) {
+    std::vector<Ruling> fan;
+    for (std::size_t k = lo; k <= hi; ++k) {
+      const int end = chain == 0 ? rulings[k].a : rulings[k].b;
+      if (!fan.empty() && fan.back().b == end) continue;
+      fan.push_back({s, end});
+    }
+    if (fan.size() < 2) continue;
+    const int fr = addRegion(g, mesh::RegionType::Curved);
+    g.regions[static_cast<std::size_t>(fr)].rulings = fan;
+    g.regions[static_cast<std::size_t>(fr)].apex = s;
+    rebuildCurvedFaces(g, fr);
+  }
+}
+
+// Appends the triangle (a, b, c), counter-clockwise in the pattern, to `region`.
+void addTriangleCCW(GeometricMesh& g, int a, int b, int c, int region) {
+  const auto P = [&](int v) -> const Vec2& {
+    return g.vertices[static_cast<std::size_t>(v)].pattern;
+  };
+  GeometricFace f;
+  f.v = {a, b, c, -1};
+  if (cross2(P(b) - P(a), P(c) - P(a)) < 0.0) std::swap(f.v[1], f.v[2]);
+  f.region = region;
+  g.faces.push_back(f);
+}
+
 // Draws a standard normal deviate from two uniforms (Box-Muller).
 double normalDeviate(const CounterRng& rng, std::uint64_t& index) {
   const double u1 = std::max(rng.uniform(index++), 1e-300);
@@ -548,20 +613,7 @@ bool splitAlongCrease(GeometricMesh& g, int region, int s1, int s2) {
     if (*it == s1) break;
   }
   if (a.size() < 3 || b.size() < 3) return false;
-  std::vector<int> inner;
-  {
-    std::vector<char> onLoop(g.vertices.size(), 0);
-    for (int v : lv) onLoop[static_cast<std::size_t>(v)] = 1;
-    for (const GeometricFace& f : g.faces) {
-      if (f.region != region) continue;
-      for (int k = 0; k < f.size(); ++k) {
-        if (!onLoop[static_cast<std::size_t>(f.v[k])]) {
-          onLoop[static_cast<std::size_t>(f.v[k])] = 1;
-          inner.push_back(f.v[k]);
-        }
-      }
-    }
-  }
+  const std::vector<int> inner = detail::innerVertices(g, region, *loop);
   removeRegionFaces(g, region);
   triangulatePolygon(g, a, addRegion(g, mesh::RegionType::Flat), inner);
   triangulatePolygon(g, b, addRegion(g, mesh::RegionType::Flat), inner);
@@ -675,32 +727,10 @@ int insertSingularInCurved(GeometricMesh& g, int flat, const Loop& loop, const B
     if (!inCell(cell, s)) cell = ksing > 0 ? ksing - 1 : 0;
   }
   // 3D position of s: barycentric in the cell's triangle holding it.
-  const std::array<int, 4> q{rulings[cell].a, rulings[cell + 1].a, rulings[cell + 1].b,
-                             rulings[cell].b};
-  GeometricVertex sv;
-  sv.pattern = s;
-  sv.singular = true;
-  bool placed = false;
-  for (const auto& tri :
-       {std::array<int, 3>{q[0], q[1], q[2]}, std::array<int, 3>{q[0], q[2], q[3]}}) {
-    const Vec2 p0 = P(tri[0]);
-    const double det = cross2(P(tri[1]) - p0, P(tri[2]) - p0);
-    if (std::abs(det) < 1e-30) continue;
-    const double l1 = cross2(s - p0, P(tri[2]) - p0) / det;
-    const double l2 = cross2(P(tri[1]) - p0, s - p0) / det;
-    const double l0 = 1.0 - l1 - l2;
-    if (l0 < -1e-9 || l1 < -1e-9 || l2 < -1e-9) continue;
-    const auto& V = g.vertices;
-    sv.position = l0 * V[static_cast<std::size_t>(tri[0])].position +
-                  l1 * V[static_cast<std::size_t>(tri[1])].position +
-                  l2 * V[static_cast<std::size_t>(tri[2])].position;
-    sv.velocity = l0 * V[static_cast<std::size_t>(tri[0])].velocity +
-                  l1 * V[static_cast<std::size_t>(tri[1])].velocity +
-                  l2 * V[static_cast<std::size_t>(tri[2])].velocity;
-    placed = true;
-    break;
-  }
+  std::optional<GeometricVertex> placed = vertexInCell(g, rulings[cell], rulings[cell + 1], s);
   if (!placed) return -1;
+  GeometricVertex sv = *placed;
+  sv.singular = true;
   // e_sup: the next ruling past s above theta_0, else C's far end.
   std::size_t sup = n;
   for (std::size_t k = cell + 1; k < n; ++k) {
@@ -716,28 +746,9 @@ int insertSingularInCurved(GeometricMesh& g, int flat, const Loop& loop, const B
   Region& c2 = g.regions[static_cast<std::size_t>(cr)];
   c2.rulings.assign(rulings.begin() + static_cast<std::ptrdiff_t>(sup), rulings.end());
   if (c2.rulings.size() >= 2) rebuildCurvedFaces(g, cr);
-  for (int chain = 0; chain < 2; ++chain) {
-    std::vector<Ruling> fan;
-    for (std::size_t k = 0; k <= sup; ++k) {
-      const int end = chain == 0 ? rulings[k].a : rulings[k].b;
-      if (!fan.empty() && fan.back().b == end) continue;
-      fan.push_back({sIndex, end});
-    }
-    if (fan.size() < 2) continue;
-    const int fr = addRegion(g, mesh::RegionType::Curved);
-    g.regions[static_cast<std::size_t>(fr)].rulings = fan;
-    g.regions[static_cast<std::size_t>(fr)].apex = sIndex;
-    rebuildCurvedFaces(g, fr);
-  }
-  const auto addTriangle = [&](int a, int b, int c, int region) {
-    GeometricFace f;
-    f.v = {a, b, c, -1};
-    if (cross2(P(b) - P(a), P(c) - P(a)) < 0.0) std::swap(f.v[1], f.v[2]);
-    f.region = region;
-    g.faces.push_back(f);
-  };
-  addTriangle(sIndex, rulings[sup].a, rulings[sup].b, addRegion(g, mesh::RegionType::Flat));
-  addTriangle(sIndex, rulings[0].a, rulings[0].b, flat);
+  addConeFans(g, sIndex, rulings, 0, sup);
+  addTriangleCCW(g, sIndex, rulings[sup].a, rulings[sup].b, addRegion(g, mesh::RegionType::Flat));
+  addTriangleCCW(g, sIndex, rulings[0].a, rulings[0].b, flat);
   return sIndex;
 }
 
@@ -819,32 +830,10 @@ void treatCurvedCompression(GeometricMesh& g, const CrumpleParams& params, const
     const Vec2 s = sa + along * (sb - sa) + d * normal;
     std::size_t cell = d >= 0.0 ? kmax : kmax - 1;
     // 3D position: barycentric in the cell's triangle holding s.
-    const std::array<int, 4> q{rulings[cell].a, rulings[cell + 1].a, rulings[cell + 1].b,
-                               rulings[cell].b};
-    GeometricVertex sv;
-    sv.pattern = s;
-    sv.singular = true;
-    bool placed = false;
-    for (const auto& tri :
-         {std::array<int, 3>{q[0], q[1], q[2]}, std::array<int, 3>{q[0], q[2], q[3]}}) {
-      const Vec2 p0 = P(tri[0]);
-      const double det = cross2(P(tri[1]) - p0, P(tri[2]) - p0);
-      if (std::abs(det) < 1e-30) continue;
-      const double l1 = cross2(s - p0, P(tri[2]) - p0) / det;
-      const double l2 = cross2(P(tri[1]) - p0, s - p0) / det;
-      const double l0 = 1.0 - l1 - l2;
-      if (l0 < -1e-9 || l1 < -1e-9 || l2 < -1e-9) continue;
-      const auto& V = g.vertices;
-      sv.position = l0 * V[static_cast<std::size_t>(tri[0])].position +
-                    l1 * V[static_cast<std::size_t>(tri[1])].position +
-                    l2 * V[static_cast<std::size_t>(tri[2])].position;
-      sv.velocity = l0 * V[static_cast<std::size_t>(tri[0])].velocity +
-                    l1 * V[static_cast<std::size_t>(tri[1])].velocity +
-                    l2 * V[static_cast<std::size_t>(tri[2])].velocity;
-      placed = true;
-      break;
-    }
+    std::optional<GeometricVertex> placed = vertexInCell(g, rulings[cell], rulings[cell + 1], s);
     if (!placed) continue;
+    GeometricVertex sv = *placed;
+    sv.singular = true;
     const EdgeMap edges = edgeMap(g);
     const auto dihedralAt = [&](const Ruling& ruling) {
       const auto it = edges.find({std::min(ruling.a, ruling.b), std::max(ruling.a, ruling.b)});
@@ -885,28 +874,9 @@ void treatCurvedCompression(GeometricMesh& g, const CrumpleParams& params, const
         rebuildCurvedFaces(g, back);
       }
       // Fans from s to both chains between r_lo and r_hi.
-      for (int chain = 0; chain < 2; ++chain) {
-        std::vector<Ruling> fan;
-        for (std::size_t k = lo; k <= hi; ++k) {
-          const int end = chain == 0 ? rulings[k].a : rulings[k].b;
-          if (!fan.empty() && fan.back().b == end) continue;
-          fan.push_back({sIndex, end});
-        }
-        if (fan.size() < 2) continue;
-        const int fr = addRegion(g, mesh::RegionType::Curved);
-        g.regions[static_cast<std::size_t>(fr)].rulings = fan;
-        g.regions[static_cast<std::size_t>(fr)].apex = sIndex;
-        rebuildCurvedFaces(g, fr);
-      }
-      const auto addTriangle = [&](int a, int b, int c, int region) {
-        GeometricFace f;
-        f.v = {a, b, c, -1};
-        if (cross2(P(b) - P(a), P(c) - P(a)) < 0.0) std::swap(f.v[1], f.v[2]);
-        f.region = region;
-        g.faces.push_back(f);
-      };
-      addTriangle(sIndex, rulings[lo].a, rulings[lo].b, addRegion(g, mesh::RegionType::Flat));
-      addTriangle(sIndex, rulings[hi].a, rulings[hi].b, addRegion(g, mesh::RegionType::Flat));
+      addConeFans(g, sIndex, rulings, lo, hi);
+      addTriangleCCW(g, sIndex, rulings[lo].a, rulings[lo].b, addRegion(g, mesh::RegionType::Flat));
+      addTriangleCCW(g, sIndex, rulings[hi].a, rulings[hi].b, addRegion(g, mesh::RegionType::Flat));
       if (const std::string problem = validate(g); !problem.empty()) {
         g = before;
         stats.notes.push_back("curved region " + std::to_string(r) + ": d-cone undone (" + problem +
