@@ -183,3 +183,111 @@ TEST(RulingPropagation, CompressionAcrossExistingRulingsInsertsASingularVertex) 
     for (const Ruling& ruling : r.rulings) EXPECT_TRUE(ruling.a == r.apex || ruling.b == r.apex);
   }
 }
+
+// Compression along a ruling of a curved region (our extension for the
+// paper's Sec. 7.4 limitation): a d-cone appears on that ruling -- one
+// singular vertex, fans of rulings from it, S_G still valid.
+TEST(RulingPropagation, CompressedRulingGetsADCone) {
+  InitialSheet sheet = makeFlatSheet(kL, kL, {}, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
+  GeometricMesh& g = sheet.mesh;
+  const auto roll = [](const Vec2& p) { return rollX(p, 0.04); };
+  deform(g, roll);
+  CrumpleParams params;
+  GeometricStepStats stats;
+  std::uint64_t draw = 0;
+  const CounterRng rng(3, 0, RngPurpose::SingularityPlacement);
+  treatCompression(
+      g, params, [&](double s) { return roll(outlinePoint(g, s)); }, rng, draw, stats);
+  ASSERT_EQ(countRegions(g, mesh::RegionType::Curved), 1);
+  const Region band =
+      g.regions.back().type == mesh::RegionType::Curved ? g.regions.back() : g.regions.front();
+  ASSERT_GE(band.rulings.size(), 6u);
+  // Shorten ruling 4 by 1 % in 3D (its b end slides towards its a end).
+  const Ruling r = band.rulings[4];
+  Vec3& xb = g.vertices[static_cast<std::size_t>(r.b)].position;
+  const Vec3 xa = g.vertices[static_cast<std::size_t>(r.a)].position;
+  xb = xa + 0.99 * (xb - xa);
+  GeometricStepStats st;
+  treatCurvedCompression(g, params, rng, draw, st);
+  ASSERT_EQ(validate(g), "");
+  EXPECT_EQ(st.singularInserted, 1);
+  ASSERT_EQ(countSingular(g), 1);
+  int s = -1;
+  for (std::size_t v = 0; v < g.vertices.size(); ++v) {
+    if (g.vertices[v].singular) s = static_cast<int>(v);
+  }
+  // Within half a ruling spacing of the compressed ruling's line (x = const).
+  const double x = g.vertices[static_cast<std::size_t>(s)].pattern.x();
+  EXPECT_LT(std::abs(x - g.vertices[static_cast<std::size_t>(r.a)].pattern.x()),
+            0.5 / params.rhoBound + 1e-12);
+  int fans = 0;
+  for (const Region& region : g.regions) fans += region.apex == s ? 1 : 0;
+  EXPECT_EQ(fans, 2);  // one fan per boundary chain (paper Fig. 11)
+}
+
+// paper Sec. 6.1, Fig. 12 right: a border ruling between a curved region and
+// a flat region bent by more than theta_high moves its junction points one
+// ruling spacing into the flat region.
+TEST(RulingPropagation, JunctionMovesIntoTheFlatRegionAboveThetaHigh) {
+  InitialSheet s2 = makeFlatSheet(kL, kL, {Vec2(0.04, 0.0), Vec2(0.04, kL)}, Vec3::Zero(),
+                                  Vec3::UnitX(), Vec3::UnitY());
+  GeometricMesh& h = s2.mesh;
+  for (int v : s2.handleVertices) h.vertices[static_cast<std::size_t>(v)].handle = false;
+  const auto rollRight = [](double from) {
+    return [from](const Vec2& p) {
+      if (p.x() <= from) return Vec3(p.x(), p.y(), 0.0);
+      const double a = (p.x() - from) / 0.05;
+      return Vec3(from + 0.05 * std::sin(a), p.y(), 0.05 * (1.0 - std::cos(a)));
+    };
+  };
+  CrumpleParams params;
+  std::uint64_t draw = 0;
+  GeometricStepStats st;
+  deform(h, rollRight(0.04));
+  treatCompression(h, params, nullptr, CounterRng(7, 0, RngPurpose::SingularityPlacement), draw,
+                   st);
+  updateJunctions(h, params, nullptr, st);  // the band shrinks to x >= 4 cm
+  ASSERT_EQ(validate(h), "");
+  // Over all curved regions: how many rulings, and the smallest x any
+  // ruling reaches (the border with the flat part x < 4 cm).
+  const auto rulingCount = [&] {
+    std::size_t n = 0;
+    for (const Region& r : h.regions)
+      n += r.type == mesh::RegionType::Curved ? r.rulings.size() : 0;
+    return n;
+  };
+  const auto rulingSpan = [&] {  // extent in x of the curved band's rulings
+    double lo = 1.0, hi = -1.0;
+    for (const Region& r : h.regions) {
+      for (const Ruling& ruling : r.rulings) {
+        const double x = h.vertices[static_cast<std::size_t>(ruling.a)].pattern.x();
+        lo = std::min(lo, x);
+        hi = std::max(hi, x);
+      }
+    }
+    return std::make_pair(lo, hi);
+  };
+  ASSERT_GE(countRegions(h, mesh::RegionType::Curved), 1);
+  const std::size_t before = rulingCount();
+  const auto [xBefore, xHiBefore] = rulingSpan();
+  // The flat part turns by 0.05 rad about the band's border ruling (x =
+  // xBefore; the band keeps its shape).
+  deform(h, [&](const Vec2& p) {
+    const Vec3 x = rollRight(0.04)(p);
+    if (p.x() >= xBefore) return x;
+    const double a = -0.05;
+    return Vec3(xBefore - (xBefore - p.x()) * std::cos(a), p.y(), (xBefore - p.x()) * std::sin(a));
+  });
+  GeometricStepStats st2;
+  updateJunctions(h, params, nullptr, st2);
+  ASSERT_EQ(validate(h), "");
+  EXPECT_EQ(st2.junctionMoves, 1);
+  EXPECT_EQ(rulingCount(), before + 1);
+  // One end moved by about one ruling spacing, onto the next boundary vertex
+  // when that is within 1.5 spacings (the first eligible end: both border
+  // flat parts bent against the band qualify).
+  const auto [xAfter, xHiAfter] = rulingSpan();
+  const double grown = (xHiAfter - xAfter) - (xHiBefore - xBefore);
+  EXPECT_GT(grown, 0.5 / params.rhoBound);
+  EXPECT_LE(grown, 1.5 / params.rhoBound + 1e-12);
+}
