@@ -59,6 +59,7 @@ struct ShotReport {
   bool hybrid = false;
   double meanCMean = 0.0;  // mean over frames of c_mean
   double maxCMean = 0.0;
+  int maxCMeanFrame = 0;
   double maxNComp = 0.0;
   int singularVertices = 0;          // at the last frame
   int interiorSingularVertices = 0;  // at the last frame
