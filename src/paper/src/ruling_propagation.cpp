@@ -1077,6 +1077,21 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
         int existingApex[2] = {-1, -1};
         for (int side = 0; side < 2; ++side) {
           const Border& b = *borders[side];
+          if (b.kind == Border::Kind::FlatFlat) {
+            // A border edge ending at a singular vertex (e.g. a crease between
+            // two): the rulings are attracted by that existing d-cone apex
+            // (Appendix B, Fig. 24 b) instead of a new one beside it.
+            const int ea = loop->v[static_cast<std::size_t>(b.loopEdge)];
+            const int eb = loop->next(static_cast<std::size_t>(b.loopEdge));
+            const bool sa = g.vertices[static_cast<std::size_t>(ea)].singular;
+            const bool sb = g.vertices[static_cast<std::size_t>(eb)].singular;
+            if (sa || sb) {
+              const double da = (g.vertices[static_cast<std::size_t>(ea)].pattern - b.hit).norm();
+              const double db = (g.vertices[static_cast<std::size_t>(eb)].pattern - b.hit).norm();
+              existingApex[side] = sa && (!sb || da <= db) ? ea : eb;
+            }
+            continue;
+          }
           if (b.kind != Border::Kind::Curved) continue;
           const int across = loop->across[static_cast<std::size_t>(b.loopEdge)];
           const int apex =
