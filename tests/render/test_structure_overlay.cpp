@@ -210,7 +210,8 @@ TEST(StructureOverlay, TriangleColoursReplaceThePaperAndKeepTheShading) {
   RenderScene below = scene;
   below.camera = Camera::lookAt(Vec3(0, -0.6, 0), Vec3::Zero(), -Vec3::UnitZ(), 0.7, w, h);
   below.lights[0].direction = Vec3(0.1, 1.0, 0.2);
-  const std::uint8_t* p = r.render(below, sheet, &o).at(w / 2, h / 2);
+  const ImageRGBA8 fromBelow = r.render(below, sheet, &o);
+  const std::uint8_t* p = fromBelow.at(w / 2, h / 2);
   EXPECT_GT(p[1], p[0] + 40);
   EXPECT_GT(p[1], p[2] + 40);
 
