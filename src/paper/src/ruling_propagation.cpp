@@ -420,6 +420,18 @@ void addTriangleCCW(GeometricMesh& g, int a, int b, int c, int region) {
   g.faces.push_back(f);
 }
 
+// Compression of an S_G triangle against its pattern (thesis 2.4.2).
+TriangleCompression faceCompression(const GeometricMesh& g, const GeometricFace& face) {
+  std::array<Vec2, 3> pattern;
+  std::array<Vec3, 3> position;
+  for (int k = 0; k < 3; ++k) {
+    pattern[static_cast<std::size_t>(k)] = g.vertices[static_cast<std::size_t>(face.v[k])].pattern;
+    position[static_cast<std::size_t>(k)] =
+        g.vertices[static_cast<std::size_t>(face.v[k])].position;
+  }
+  return analyzeCompression(pattern, position);
+}
+
 // Draws a standard normal deviate from two uniforms (Box-Muller).
 double normalDeviate(const CounterRng& rng, std::uint64_t& index) {
   const double u1 = std::max(rng.uniform(index++), 1e-300);
@@ -987,16 +999,8 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
             g.regions[static_cast<std::size_t>(face.region)].type != mesh::RegionType::Flat) {
           continue;
         }
-        std::array<Vec2, 3> pat;
-        std::array<Vec3, 3> pos;
-        for (int k = 0; k < 3; ++k) {
-          pat[static_cast<std::size_t>(k)] =
-              g.vertices[static_cast<std::size_t>(face.v[k])].pattern;
-          pos[static_cast<std::size_t>(k)] =
-              g.vertices[static_cast<std::size_t>(face.v[k])].position;
-        }
         double& w = worst[static_cast<std::size_t>(face.region)];
-        w = std::max(w, analyzeCompression(pat, pos).ratio());
+        w = std::max(w, faceCompression(g, face).ratio());
       }
       for (std::size_t r = 0; r < regionCount; ++r) order.emplace_back(-worst[r], r);
       std::sort(order.begin(), order.end());
@@ -1010,15 +1014,7 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
       for (std::size_t f = 0; f < g.faces.size(); ++f) {
         const GeometricFace& face = g.faces[f];
         if (face.region != static_cast<int>(r) || face.size() != 3) continue;
-        std::array<Vec2, 3> pat;
-        std::array<Vec3, 3> pos;
-        for (int k = 0; k < 3; ++k) {
-          pat[static_cast<std::size_t>(k)] =
-              g.vertices[static_cast<std::size_t>(face.v[k])].pattern;
-          pos[static_cast<std::size_t>(k)] =
-              g.vertices[static_cast<std::size_t>(face.v[k])].position;
-        }
-        const TriangleCompression c = analyzeCompression(pat, pos);
+        const TriangleCompression c = faceCompression(g, face);
         if (c.lambdaMin < best.lambdaMin) {
           best = c;
           tcomp = static_cast<int>(f);
