@@ -14,6 +14,7 @@
 #include "crumple/paper/boundary_curve.hpp"
 #include "crumple/paper/cone_fit.hpp"
 #include "crumple/paper/damage.hpp"
+#include "region_tools.hpp"
 
 namespace crumple::paper {
 
@@ -48,23 +49,14 @@ struct HybridSheet::Impl {
   // many more steps each point blocks remeshing of the region holding it.
   std::vector<std::pair<Vec2, int>> recentCuts;
 
-  // Whether face f holds a recent cut (pattern point in polygon).
+  // Whether face f holds a recent cut (at one of its vertices or inside it).
   bool holdsRecentCut(const GeometricFace& f) const {
+    const std::span<const int> corners(f.v.data(), static_cast<std::size_t>(f.size()));
     for (const auto& [p, left] : recentCuts) {
-      bool inside = false;
-      const int n = f.size();
-      for (int k = 0; k < n; ++k) {
-        if ((sg.vertices[static_cast<std::size_t>(f.v[k])].pattern - p).norm() < 1e-9) return true;
+      for (int v : corners) {
+        if ((sg.vertices[static_cast<std::size_t>(v)].pattern - p).norm() < 1e-9) return true;
       }
-      for (int k = 0; k < n; ++k) {
-        const Vec2& a = sg.vertices[static_cast<std::size_t>(f.v[k])].pattern;
-        const Vec2& b = sg.vertices[static_cast<std::size_t>(f.v[(k + 1) % n])].pattern;
-        if ((a.y() > p.y()) != (b.y() > p.y()) &&
-            a.x() + (p.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y()) > p.x()) {
-          inside = !inside;
-        }
-      }
-      if (inside) return true;
+      if (detail::pointInPolygon(sg, corners, p)) return true;
     }
     return false;
   }

@@ -51,17 +51,22 @@ std::optional<Loop> regionLoop(const GeometricMesh& g, int region, const EdgeMap
   return loop;
 }
 
-bool insideLoop(const GeometricMesh& g, const Loop& loop, const Vec2& p) {
+bool pointInPolygon(const GeometricMesh& g, std::span<const int> polygon, const Vec2& p) {
   bool inside = false;
-  for (std::size_t k = 0; k < loop.size(); ++k) {
-    const Vec2& a = g.vertices[static_cast<std::size_t>(loop.v[k])].pattern;
-    const Vec2& b = g.vertices[static_cast<std::size_t>(loop.next(k))].pattern;
-    if ((a.y() > p.y()) != (b.y() > p.y())) {
-      const double x = a.x() + (p.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y());
-      if (x > p.x()) inside = !inside;
+  const std::size_t n = polygon.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec2& a = g.vertices[static_cast<std::size_t>(polygon[k])].pattern;
+    const Vec2& b = g.vertices[static_cast<std::size_t>(polygon[(k + 1) % n])].pattern;
+    if ((a.y() > p.y()) != (b.y() > p.y()) &&
+        a.x() + (p.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y()) > p.x()) {
+      inside = !inside;
     }
   }
   return inside;
+}
+
+bool insideLoop(const GeometricMesh& g, const Loop& loop, const Vec2& p) {
+  return pointInPolygon(g, loop.v, p);
 }
 
 std::vector<int> innerVertices(const GeometricMesh& g, int region, const Loop& loop) {
@@ -112,16 +117,7 @@ void triangulatePolygon(GeometricMesh& g, const std::vector<int>& polygon, int r
   }
   for (int v : inner) {
     const Vec2& p = g.vertices[static_cast<std::size_t>(v)].pattern;
-    bool inside = false;
-    for (std::size_t k = 0; k < polygon.size(); ++k) {
-      const Vec2& a = points[k];
-      const Vec2& b = points[(k + 1) % polygon.size()];
-      if ((a.y() > p.y()) != (b.y() > p.y()) &&
-          a.x() + (p.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y()) > p.x()) {
-        inside = !inside;
-      }
-    }
-    if (!inside) continue;
+    if (!pointInPolygon(g, polygon, p)) continue;
     points.push_back(p);
     ids.push_back(v);
   }

@@ -4,6 +4,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "crumple/paper/geometric_mesh.hpp"
@@ -28,6 +29,9 @@ struct Loop {
 
 // nullopt when the region has several loops (holes) or pinches.
 std::optional<Loop> regionLoop(const GeometricMesh& g, int region, const EdgeMap& edges);
+
+// Point-in-polygon test (even-odd rule) for a polygon of S_G vertices.
+bool pointInPolygon(const GeometricMesh& g, std::span<const int> polygon, const Vec2& p);
 
 // Point-in-polygon test against the loop (even-odd rule).
 bool insideLoop(const GeometricMesh& g, const Loop& loop, const Vec2& p);
