@@ -126,17 +126,23 @@ std::size_t BoundaryCurve::interval(double s) const {
   return static_cast<std::size_t>(it - s_.begin()) - 1;
 }
 
+BoundaryCurve::Span BoundaryCurve::locate(double s) const {
+  double w = wrapParameter(s, perimeter_);
+  Span span;
+  span.k = interval(w);
+  span.k1 = (span.k + 1) % s_.size();
+  if (w < s_[span.k]) w += perimeter_;
+  span.h = spacing(span.k);
+  span.u = (w - s_[span.k]) / span.h;
+  return span;
+}
+
 // paper Sec. 6.2: cubic interpolation of the 3D boundary curve at s.
 Vec3 BoundaryCurve::evaluate(double s) const {
   if (!std::isfinite(s))
     throw NumericalError("cones", "boundary curve evaluated at a non-finite parameter");
   if (s_.size() == 1) return x_.front();
-  double w = wrapParameter(s, perimeter_);
-  const std::size_t k = interval(w);
-  const std::size_t k1 = (k + 1) % s_.size();
-  if (w < s_[k]) w += perimeter_;
-  const double h = spacing(k);
-  const double u = (w - s_[k]) / h;
+  const auto [k, k1, u, h] = locate(s);
   const double u2 = u * u;
   const double u3 = u2 * u;
   const double h00 = 2.0 * u3 - 3.0 * u2 + 1.0;
@@ -152,12 +158,7 @@ Vec3 BoundaryCurve::derivative(double s) const {
   if (!std::isfinite(s))
     throw NumericalError("cones", "boundary curve evaluated at a non-finite parameter");
   if (s_.size() == 1) return Vec3::Zero();
-  double w = wrapParameter(s, perimeter_);
-  const std::size_t k = interval(w);
-  const std::size_t k1 = (k + 1) % s_.size();
-  if (w < s_[k]) w += perimeter_;
-  const double h = spacing(k);
-  const double u = (w - s_[k]) / h;
+  const auto [k, k1, u, h] = locate(s);
   const double u2 = u * u;
   const double d00 = (6.0 * u2 - 6.0 * u) / h;
   const double d10 = 3.0 * u2 - 4.0 * u + 1.0;

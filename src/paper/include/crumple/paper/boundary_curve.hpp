@@ -60,6 +60,12 @@ class BoundaryCurve {
   // Index k of the interval [s_k, s_{k+1}) holding s (already wrapped).
   std::size_t interval(double s) const;
   double spacing(std::size_t k) const;  // s_{k+1} - s_k, periodic
+  // Where s falls: interval k (from sample k to k1), local u in [0, 1), width h.
+  struct Span {
+    std::size_t k = 0, k1 = 0;
+    double u = 0.0, h = 0.0;
+  };
+  Span locate(double s) const;
 
   double perimeter_ = 0.0;
   std::vector<double> s_;
