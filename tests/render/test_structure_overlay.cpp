@@ -72,12 +72,18 @@ double segmentDistance(const Vec2& q, const Vec2& a, const Vec2& b) {
 
 const StructurePalette kPalette;
 
-TEST(StructureOverlay, PointPixelHasThePointsColour) {
-  const int w = 200, h = 150;
-  OsmesaRenderer r(w, h);
-  const RenderScene scene = topScene(w, h);
+// The 200 x 150 view from above onto the flat test sheet that most property
+// tests below share, with an empty overlay to fill in.
+class StructureOverlayTopView : public ::testing::Test {
+ protected:
+  static constexpr int w = 200, h = 150;
+  OsmesaRenderer r{w, h};
+  RenderScene scene = topScene(w, h);
   const mesh::SheetMesh sheet = flatSheet(0.0);
   StructureOverlay o;
+};
+
+TEST_F(StructureOverlayTopView, PointPixelHasThePointsColour) {
   const std::array<Vec3, 3> where = {onFlatSheet(0.05, 0.10), onFlatSheet(0.15, 0.20),
                                      onFlatSheet(0.10, 0.05)};
   const std::array<Vec3, 3> colors = {kPalette.singular, kPalette.junction, kPalette.handle};
@@ -99,12 +105,7 @@ TEST(StructureOverlay, PointPixelHasThePointsColour) {
   EXPECT_NEAR(coverage, std::numbers::pi * radius * radius, 2.0);
 }
 
-TEST(StructureOverlay, PointsBehindThePaperAreHidden) {
-  const int w = 200, h = 150;
-  OsmesaRenderer r(w, h);
-  const RenderScene scene = topScene(w, h);
-  const mesh::SheetMesh sheet = flatSheet(0.0);
-  StructureOverlay o;
+TEST_F(StructureOverlayTopView, PointsBehindThePaperAreHidden) {
   const Vec3 below = onFlatSheet(0.10, 0.15, -0.02);  // 2 cm under the sheet
   const Vec3 above = onFlatSheet(0.05, 0.15, 0.0);    // on it
   o.points = {{below, kPalette.singular}, {above, kPalette.singular}};
@@ -116,12 +117,7 @@ TEST(StructureOverlay, PointsBehindThePaperAreHidden) {
   EXPECT_LE(colorDistance(pixelAt(img, scene.camera, above), srgb(kPalette.singular)), 1);
 }
 
-TEST(StructureOverlay, LineMidpointHasTheLinesColourAndItsWidth) {
-  const int w = 200, h = 150;
-  OsmesaRenderer r(w, h);
-  const RenderScene scene = topScene(w, h);
-  const mesh::SheetMesh sheet = flatSheet(0.0);
-  StructureOverlay o;
+TEST_F(StructureOverlayTopView, LineMidpointHasTheLinesColourAndItsWidth) {
   o.lineWidthPx = 4.0;
   // Horizontal in the image (world X), and a diagonal one.
   const Vec3 a = onFlatSheet(0.03, 0.2), b = onFlatSheet(0.18, 0.2);
@@ -187,12 +183,7 @@ TEST(StructureOverlay, LinesStayWholeOnATiltedSurfaceAndHiddenBehindThePaper) {
           << "hidden line drawn at " << x << "," << y;
 }
 
-TEST(StructureOverlay, TriangleColoursReplaceThePaperAndKeepTheShading) {
-  const int w = 200, h = 150;
-  OsmesaRenderer r(w, h);
-  RenderScene scene = topScene(w, h);
-  const mesh::SheetMesh sheet = flatSheet(0.0);
-  StructureOverlay o;
+TEST_F(StructureOverlayTopView, TriangleColoursReplaceThePaperAndKeepTheShading) {
   o.triangleColors.assign(sheet.triangleCount(), kPalette.flat);
   const ImageRGBA8 img = r.render(scene, sheet, &o);
   maybeDump("overlay_green", img);
@@ -300,12 +291,7 @@ TEST(StructureOverlay, LinesAndPointsLeaveTheRestOfTheImageUntouched) {
   EXPECT_GT(changedNear, near / 4);
 }
 
-TEST(StructureOverlay, PointsAreDrawnOverLines) {
-  const int w = 200, h = 150;
-  OsmesaRenderer r(w, h);
-  const RenderScene scene = topScene(w, h);
-  const mesh::SheetMesh sheet = flatSheet(0.0);
-  StructureOverlay o;
+TEST_F(StructureOverlayTopView, PointsAreDrawnOverLines) {
   o.lineWidthPx = 6.0;
   const Vec3 a = onFlatSheet(0.03, 0.15), b = onFlatSheet(0.18, 0.15);
   o.points = {{0.5 * (a + b), kPalette.junction}};  // listed first, drawn last
