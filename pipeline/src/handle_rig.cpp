@@ -1,5 +1,6 @@
 #include "crumple/pipeline/handle_rig.hpp"
 
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -165,13 +166,30 @@ void HandleRig::rebindTangents(const mesh::SheetMesh& sheet, double t) {
     h.tangentOffsets.clear();
     if (h.releases && t >= h.releaseTime) continue;
     const Pose pose = animation_->worldPose(h.node, t);
+    // Where the tangent vertices are now, in the node's frame, and where the
+    // pattern puts them around the handle vertex (in its plane, z = 0).
+    std::vector<Vec3> now;
+    std::vector<Vec3> flat;
+    const Vec2 centre = sheet.pattern[static_cast<std::size_t>(h.vertex)];
     for (int n : tangentNeighbours(sheet, h.vertex, h.tangentCount)) {
       if (held[static_cast<std::size_t>(n)]) continue;  // another handle's vertex
       held[static_cast<std::size_t>(n)] = 1;
       h.tangentVertices.push_back(n);
-      h.tangentOffsets.push_back(pose.rotation.conjugate() *
-                                 (sheet.positions[static_cast<std::size_t>(n)] - pose.position));
+      now.push_back(pose.rotation.conjugate() *
+                    (sheet.positions[static_cast<std::size_t>(n)] - pose.position));
+      const Vec2 d = sheet.pattern[static_cast<std::size_t>(n)] - centre;
+      flat.emplace_back(d.x(), d.y(), 0.0);
     }
+    // The offsets are the pattern's, rigidly turned to fit where the vertices
+    // are (Kabsch): the tangent plane follows the sheet, but the pins never
+    // freeze a stretched or compressed neighbourhood into the handle.
+    Mat3 cov = Mat3::Zero();
+    for (std::size_t k = 0; k < now.size(); ++k) cov += flat[k] * now[k].transpose();
+    const Eigen::JacobiSVD<Mat3> svd(cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Mat3 fix = Mat3::Identity();
+    fix(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+    const Mat3 turn = svd.matrixV() * fix * svd.matrixU().transpose();
+    for (const Vec3& f : flat) h.tangentOffsets.push_back(turn * f);
   }
 }
 

@@ -540,12 +540,17 @@ TEST(ConeFit, RefitMakesParallelRulingsConvergeToTheApex) {
   RecordProperty("rulings_through_apex", throughApex);
   RecordProperty("worst_apex_distance_m", sci(worst));
   EXPECT_GE(throughApex, 4);
-  // Spacing along both sides <= 1 / rho_bound.
+  // Spacing along both sides <= 1 / rho_bound, and consecutive ends either
+  // one vertex (a fan) or at least half of it apart (no sliver cells).
   for (std::size_t k = 1; k < rulings.size(); ++k) {
-    EXPECT_LE((pat(g, rulings[k].a) - pat(g, rulings[k - 1].a)).norm(),
-              1.0 / params.rhoBound + 1e-12);
-    EXPECT_LE((pat(g, rulings[k].b) - pat(g, rulings[k - 1].b)).norm(),
-              1.0 / params.rhoBound + 1e-12);
+    for (const auto& [x, y] :
+         {std::pair{rulings[k - 1].a, rulings[k].a}, std::pair{rulings[k - 1].b, rulings[k].b}}) {
+      const double gap = (pat(g, x) - pat(g, y)).norm();
+      EXPECT_LE(gap, 1.0 / params.rhoBound + 1e-12) << "rulings " << k - 1 << ", " << k;
+      if (x != y) {
+        EXPECT_GE(gap, 0.5 / params.rhoBound - 1e-12) << "rulings " << k - 1 << ", " << k;
+      }
+    }
   }
   // New vertices lie on the 3D boundary curve, on the outline.
   for (const Ruling& r : rulings) {
@@ -759,4 +764,33 @@ TEST(ConeFit, RefitSkipsRegionsWithAnApexAndRejectsFlatOnes) {
   EXPECT_FALSE(res.changed);
   EXPECT_FALSE(res.skipped.empty());
   EXPECT_EQ(g.faces.size(), faces);
+}
+
+// A sharp cone (apex 1.5 cm below the sheet): spaced at 1/rho_bound on the
+// far border, its rulings crowd the near one. Consecutive ruling ends are
+// one vertex or at least half the spacing apart (the refit thins them):
+// ends a millimetre apart made sliver cells that stalled the elastic solve.
+TEST(ConeFit, RefitOfASharpConeKeepsRulingEndsApart) {
+  const DevelopedCone cone{Vec2(0.05, -0.015), 0.25};
+  const auto embed = [&](const Vec2& p) { return cone.embed(p); };
+  StripSheet sheet = makeStrip({0.02, 0.035, 0.05, 0.065, 0.08}, embed);
+  GeometricMesh& g = sheet.g;
+  const BoundaryCurve curve = outlineCurve(g, embed);
+  ASSERT_EQ(validate(g), "");
+  const CrumpleParams params;
+  const ConeRefitResult res = refitCurvedRegion(g, 1, curve, params, 0.1);
+  ASSERT_TRUE(res.changed) << res.skipped;
+  const std::vector<Ruling>& rulings = g.regions[1].rulings;
+  ASSERT_GE(rulings.size(), 5u);
+  for (std::size_t k = 1; k < rulings.size(); ++k) {
+    for (const auto& [x, y] :
+         {std::pair{rulings[k - 1].a, rulings[k].a}, std::pair{rulings[k - 1].b, rulings[k].b}}) {
+      if (x == y) continue;
+      EXPECT_GE((pat(g, x) - pat(g, y)).norm(), 0.5 / params.rhoBound - 1e-12)
+          << "rulings " << k - 1 << ", " << k;
+    }
+  }
+  compact(g);
+  EXPECT_EQ(validate(g), "");
+  RecordProperty("rulings", static_cast<int>(rulings.size()));
 }

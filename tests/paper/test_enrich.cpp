@@ -476,3 +476,29 @@ TEST(Enrich, RejectsBadInput) {
   g.faces[1].region = 3;
   EXPECT_THROW(buildPhysicalMesh(g, CrumpleParams{}), std::invalid_argument);
 }
+
+// Sliver hinges (CrumpleParams::sliverHingeRatio): a hinge between two thin
+// triangles is softened by (A1 + A2) / |e|^2 / ratio; well-shaped hinges and
+// boundary edges keep their stiffness.
+TEST(Enrich, SliverHingesAreSoftenedInProportion) {
+  mesh::SheetMesh sp;
+  // Two hinges: a unit square split on its diagonal (ratio (0.5 + 0.5) / 2 =
+  // 0.5), and a 10 x 0.1 sliver pair sharing its long edge.
+  sp.pattern = {Vec2(0, 0), Vec2(1, 0),  Vec2(1, 1),   Vec2(0, 1),
+                Vec2(3, 0), Vec2(13, 0), Vec2(8, 0.1), Vec2(8, -0.1)};
+  sp.positions.resize(sp.pattern.size(), Vec3::Zero());
+  sp.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {5, 4, 7}};
+  const auto edges = mesh::buildEdges(sp);
+  std::vector<mesh::MeshEdge> hinges;
+  for (const auto& e : edges)
+    if (e.interior()) hinges.push_back(e);
+  ASSERT_EQ(hinges.size(), 2u);
+  const auto factors = sliverHingeFactors(sp, hinges, 0.1);
+  for (std::size_t h = 0; h < hinges.size(); ++h) {
+    const bool diagonal = hinges[h].v[0] == 0;
+    // Sliver: (0.5 + 0.5) / 100 = 0.01, a tenth of the ratio.
+    EXPECT_NEAR(factors[h], diagonal ? 1.0 : 0.1, 1e-12) << "hinge " << h;
+  }
+  // A ratio of 0 switches the softening off.
+  for (double f : sliverHingeFactors(sp, hinges, 0.0)) EXPECT_EQ(f, 1.0);
+}

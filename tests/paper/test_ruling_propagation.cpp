@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <functional>
+#include <numbers>
 
 #include "crumple/paper/geometric_step.hpp"
 #include "crumple/paper/initial_sheet.hpp"
@@ -35,6 +36,27 @@ int countSingular(const GeometricMesh& g) {
   int n = 0;
   for (const GeometricVertex& v : g.vertices) n += v.singular ? 1 : 0;
   return n;
+}
+
+// Consecutive ruling ends of every curved region are one vertex (a fan) or
+// at least half the ruling spacing apart on both sides.
+void expectRulingEndsApart(const GeometricMesh& g, const CrumpleParams& params) {
+  const auto P = [&](int v) -> const Vec2& {
+    return g.vertices[static_cast<std::size_t>(v)].pattern;
+  };
+  for (std::size_t c = 0; c < g.regions.size(); ++c) {
+    const Region& region = g.regions[c];
+    if (region.type != mesh::RegionType::Curved) continue;
+    for (std::size_t k = 1; k < region.rulings.size(); ++k) {
+      const Ruling& q = region.rulings[k - 1];
+      const Ruling& r = region.rulings[k];
+      for (const auto& [x, y] : {std::pair{q.a, r.a}, std::pair{q.b, r.b}}) {
+        if (x == y) continue;
+        EXPECT_GE((P(x) - P(y)).norm(), 0.5 / params.rhoBound - 1e-12)
+            << "region " << c << ", rulings " << k - 1 << " and " << k;
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -152,6 +174,7 @@ TEST(RulingPropagation, CompressionAcrossExistingRulingsInsertsASingularVertex) 
     EXPECT_TRUE(h.vertices[static_cast<std::size_t>(r.apex)].singular);
     for (const Ruling& ruling : r.rulings) EXPECT_TRUE(ruling.a == r.apex || ruling.b == r.apex);
   }
+  expectRulingEndsApart(h, params);
 }
 
 // Compression along a ruling of a curved region (our extension for the
@@ -260,4 +283,49 @@ TEST(RulingPropagation, JunctionMovesIntoTheFlatRegionAboveThetaHigh) {
   const double grown = (xHiAfter - xAfter) - (xHiBefore - xBefore);
   EXPECT_GT(grown, 0.5 / params.rhoBound);
   EXPECT_LE(grown, 1.5 / params.rhoBound + 1e-12);
+}
+
+// A long strip rolled about an axis 3 degrees off its short side (the
+// moebius sample's first bend): the strip of chords ends in thin wedges at
+// the corners. No ruling may run along the outline, and consecutive ruling
+// ends are either one vertex (a fan) or at least half the ruling spacing
+// apart: ends millimetres apart made sliver cells that stalled the elastic
+// solve.
+TEST(RulingPropagation, TiltedRollOfAStripKeepsRulingEndsApart) {
+  constexpr double kW = 0.24, kH = 0.03, kR = 0.05;
+  const double tilt = 3.0 * std::numbers::pi / 180.0;
+  const Vec2 axis(std::sin(tilt), std::cos(tilt));  // pattern direction of the rulings
+  const Vec2 across(axis.y(), -axis.x());
+  const auto roll = [&](const Vec2& p) {
+    const double u = (p - Vec2(0.5 * kW, 0.5 * kH)).dot(across);
+    const double v = (p - Vec2(0.5 * kW, 0.5 * kH)).dot(axis);
+    return Vec3(kR * std::sin(u / kR), v, kR * (1.0 - std::cos(u / kR)));
+  };
+  InitialSheet sheet = makeFlatSheet(kW, kH, {}, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
+  GeometricMesh& g = sheet.mesh;
+  deform(g, roll);
+  CrumpleParams params;
+  GeometricStepStats stats;
+  std::uint64_t draw = 0;
+  const BoundaryPosition boundary = [&](double s) { return roll(outlinePoint(g, s)); };
+  treatCompression(g, params, boundary, CounterRng(1, 0, RngPurpose::SingularityPlacement), draw,
+                   stats);
+  ASSERT_EQ(validate(g), "");
+  ASSERT_GE(stats.curvedCreated, 1);
+  EXPECT_EQ(countSingular(g), 0);
+  expectRulingEndsApart(g, params);
+  for (const Region& region : g.regions) {
+    if (region.type != mesh::RegionType::Curved) continue;
+    for (std::size_t k = 0; k < region.rulings.size(); ++k) {
+      const Ruling& r = region.rulings[k];
+      const GeometricVertex& a = g.vertices[static_cast<std::size_t>(r.a)];
+      const GeometricVertex& b = g.vertices[static_cast<std::size_t>(r.b)];
+      // Along a short side of the outline only as that whole side (the
+      // strip's limit), never along a piece of it.
+      if (std::abs(a.pattern.x() - b.pattern.x()) < 1e-12 &&
+          (a.pattern.x() < 1e-12 || a.pattern.x() > kW - 1e-12)) {
+        EXPECT_TRUE(a.corner && b.corner) << "ruling " << k << " runs along part of a short side";
+      }
+    }
+  }
 }

@@ -7,11 +7,13 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <numbers>
 
 #include "crumple/core/error.hpp"
 #include "crumple/core/parallel.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
+#include "crumple/sim/energies.hpp"
 
 using namespace crumple;
 using namespace crumple::sim;
@@ -359,4 +361,135 @@ TEST(ElasticSheet, RejectsBadInput) {
   Material bad = officePaper();
   bad.poissonRatio = 0.5;
   EXPECT_THROW(ElasticSheet(m, bad, SimParams{}), std::invalid_argument);
+}
+
+namespace {
+
+// Two triangles sharing the hinge 0-1 along the x axis, in the plane z = 0.
+// The wings differ (2 at (0.01, 0.015), 3 at (0.008, -0.013)) so that
+// wing 3 never lands on wing 2 when it is rotated about the hinge.
+mesh::SheetMesh twoTriangleHinge() {
+  mesh::SheetMesh m;
+  m.pattern = {Vec2(0, 0), Vec2(0.02, 0), Vec2(0.01, 0.015), Vec2(0.008, -0.013)};
+  m.triangles = {{0, 1, 2}, {1, 0, 3}};
+  m.regionOfTriangle = {0, 0};
+  m.regionTypes = {mesh::RegionType::Flat};
+  mesh::placePattern(m, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
+  return m;
+}
+
+// The mesh's positions with wing 3 rigidly rotated by `phi` about the hinge
+// (the x axis), towards -z for phi > 0: the fold angle is phi.
+std::vector<Vec3> foldedWing(const mesh::SheetMesh& m, double phi) {
+  std::vector<Vec3> x = m.positions;
+  const double y = m.positions[3].y();
+  x[3] = Vec3(m.positions[3].x(), y * std::cos(phi), y * std::sin(phi));
+  return x;
+}
+
+// The hinge stiffness k as ElasticSheet computes it (factor 1).
+double twoTriangleHingeStiffness(const mesh::SheetMesh& m) {
+  const auto& p = m.pattern;
+  const double a0 = triangleRest(p[0], p[1], p[2]).area;
+  const double a1 = triangleRest(p[1], p[0], p[3]).area;
+  return hingeStiffness(officePaper().bendingStiffness(), 1.0, (p[1] - p[0]).squaredNorm(), a0, a1);
+}
+
+constexpr double kFoldStep = 0.1;  // rad per setPositions call
+constexpr int kFoldSteps = 38;     // 3.8 rad, about 1.21 pi
+
+}  // namespace
+
+TEST(ElasticSheet, HingeAngleStaysContinuousWhenFoldedPastPi) {
+  // Rotating one wing about the hinge in 0.1 rad steps up to ~1.2 pi: the
+  // measured angle follows the rotation past pi (atan2 alone would jump to
+  // -pi + ... and report ~ -0.8 pi at the end) and the bending energy keeps
+  // growing as k theta^2 (on the wrapped branch it would fall again past pi).
+  const mesh::SheetMesh m = twoTriangleHinge();
+  ElasticSheet sheet(m, officePaper(), SimParams{});
+  ASSERT_EQ(sheet.hinges().size(), 1u);
+  const double k = twoTriangleHingeStiffness(m);
+  ASSERT_GT(k, 0.0);
+  EXPECT_NEAR(sheet.hingeAngle(0), 0.0, 1e-12);
+
+  // Sign convention: wing towards -z is a positive fold.
+  sheet.setPositions(foldedWing(m, 0.05));
+  EXPECT_NEAR(sheet.hingeAngle(0), 0.05, 1e-9);
+
+  double lastEnergy = sheet.bendingEnergy();
+  for (int i = 1; i <= kFoldSteps; ++i) {
+    const double phi = i * kFoldStep;
+    sheet.setPositions(foldedWing(m, phi));
+    ASSERT_NEAR(sheet.hingeAngle(0), phi, 1e-9) << "phi " << phi;
+    const double energy = sheet.bendingEnergy();
+    ASSERT_NEAR(energy, k * phi * phi, 1e-9 * k * phi * phi) << "phi " << phi;
+    ASSERT_GT(energy, lastEnergy) << "phi " << phi;
+    lastEnergy = energy;
+  }
+  EXPECT_GT(sheet.hingeAngle(0), 1.2 * std::numbers::pi);
+  // A pure rotation about the hinge does not stretch anything.
+  EXPECT_LT(sheet.maxMembraneStrain(), 1e-12);
+}
+
+TEST(ElasticSheet, HingeAngleUnwindsContinuouslyBackToFlat) {
+  // Fold past pi, then rotate back down to flat and on to a small negative
+  // fold: the angle retraces the rotation through pi and ends at 0 and then
+  // -0.3 on the original branch, with the energy k theta^2 all the way.
+  const mesh::SheetMesh m = twoTriangleHinge();
+  ElasticSheet sheet(m, officePaper(), SimParams{});
+  const double k = twoTriangleHingeStiffness(m);
+  for (int i = 1; i <= kFoldSteps; ++i) sheet.setPositions(foldedWing(m, i * kFoldStep));
+  ASSERT_NEAR(sheet.hingeAngle(0), kFoldSteps * kFoldStep, 1e-9);
+
+  for (int i = kFoldSteps - 1; i >= -3; --i) {
+    const double phi = i * kFoldStep;
+    sheet.setPositions(foldedWing(m, phi));
+    ASSERT_NEAR(sheet.hingeAngle(0), phi, 1e-9) << "phi " << phi;
+    ASSERT_NEAR(sheet.bendingEnergy(), k * phi * phi, 1e-9 * k * phi * phi + 1e-20)
+        << "phi " << phi;
+  }
+  sheet.setPositions(m.positions);
+  EXPECT_NEAR(sheet.hingeAngle(0), 0.0, 1e-12);
+  EXPECT_LT(sheet.bendingEnergy(), 1e-20);
+}
+
+TEST(ElasticSheet, HingeFoldedPastPiUnfoldsTheWayItCame) {
+  // Folded to ~1.2 pi (rest angle 0) and released with triangle A pinned:
+  // the bending force pulls the wing back through pi, across the -z side
+  // (0 < theta < pi) to flat. With the wrapped angle (~ -0.8 pi) the force
+  // would point the other way and the wing would finish the turn through
+  // the +z side to 2 pi instead.
+  const mesh::SheetMesh m = twoTriangleHinge();
+  SimParams p;
+  p.gravity = Vec3::Zero();
+  p.massDamping = 5.0;
+  ElasticSheet sheet(m, officePaper(), p);
+  for (int i = 1; i <= kFoldSteps; ++i) sheet.setPositions(foldedWing(m, i * kFoldStep));
+  ASSERT_GT(sheet.hingeAngle(0), std::numbers::pi);
+  const PinFunction pins = [&](double, std::vector<Pin>& out) {
+    for (int i = 0; i < 3; ++i) out.push_back({i, m.positions[static_cast<std::size_t>(i)]});
+  };
+  // Short steps first, so the path can be followed, then long ones to rest.
+  const double start = sheet.hingeAngle(0);
+  double minZ = sheet.positions()[3].z();
+  double lastAngle = start;
+  double t = 0.0;
+  for (int step = 0; step < 300; ++step) {
+    const double dt = step < 200 ? 2e-4 : 1e-2;
+    sheet.advance(t, dt, pins);
+    t += dt;
+    minZ = std::min(minZ, sheet.positions()[3].z());
+    const double angle = sheet.hingeAngle(0);
+    // First it folds back towards pi (not on towards 2 pi) ...
+    if (step == 0) {
+      EXPECT_LT(angle, start);
+      EXPECT_GT(angle, std::numbers::pi);
+    }
+    // ... and the measured angle never jumps by a branch.
+    ASSERT_LT(std::abs(angle - lastAngle), 0.5) << "step " << step;
+    lastAngle = angle;
+  }
+  EXPECT_LT(minZ, -0.01);  // it swept through the -z half-space (|y_3| = 0.013)
+  EXPECT_NEAR(sheet.hingeAngle(0), 0.0, 1e-6);
+  EXPECT_LT(sheet.bendingEnergy(), 1e-15);
 }

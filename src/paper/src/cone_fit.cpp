@@ -912,15 +912,17 @@ std::string RunRefitter::run(RunResult& out) {
     dense.push_back(out.rulings[k]);
   }
 
-  // Snap new endpoints within 2% of the spacing onto kept vertices of the
-  // same chain (no slivers), then drop repeated rulings.
+  // Snap new endpoints within a quarter of the spacing onto kept vertices of
+  // the same chain, then drop repeated rulings and new rulings closer than
+  // half the spacing to a neighbour on either chain: ends millimetres apart
+  // make sliver triangles in S_P that stall the elastic solve.
   std::array<std::vector<FixedPoint>, 2> kept;
   for (const ChainRuling& r : dense) {
     for (std::size_t c = 0; c < 2; ++c) {
       if (r.v[c] >= 0) kept[c].push_back({r.t[c], r.v[c]});
     }
   }
-  const double snap = 0.02 * ctx_.spacing;
+  const double snap = 0.25 * ctx_.spacing;
   for (ChainRuling& r : dense) {
     for (std::size_t c = 0; c < 2; ++c) {
       if (r.v[c] >= 0) continue;
@@ -944,6 +946,39 @@ std::string RunRefitter::run(RunResult& out) {
       if (std::abs(p.t[0] - r.t[0]) <= eps_ && std::abs(p.t[1] - r.t[1]) <= eps_) continue;
     }
     out.rulings.push_back(r);
+  }
+  {
+    const double minGap = 0.5 * ctx_.spacing;
+    // A ruling may go when each of its vertices is new or stays a ruling
+    // end through a neighbour (the apex of a fan).
+    const auto isNew = [&](std::size_t k) {
+      const ChainRuling& r = out.rulings[k];
+      for (std::size_t c = 0; c < 2; ++c) {
+        if (r.v[c] < 0) continue;
+        const bool shared = (k > 0 && out.rulings[k - 1].v[c] == r.v[c]) ||
+                            (k + 1 < out.rulings.size() && out.rulings[k + 1].v[c] == r.v[c]);
+        if (!shared) return false;
+      }
+      return true;
+    };
+    const auto spaced = [&](const ChainRuling& a, const ChainRuling& b) {
+      for (std::size_t c = 0; c < 2; ++c) {
+        const double gap = std::abs(b.t[c] - a.t[c]);
+        if (gap > eps_ && gap < minGap) return false;
+      }
+      return true;
+    };
+    std::vector<ChainRuling> thinned;
+    for (std::size_t k = 0; k < out.rulings.size(); ++k) {
+      const ChainRuling& r = out.rulings[k];
+      if (isNew(k) && k > 0 && k + 1 < out.rulings.size()) {
+        std::size_t next = k + 1;  // the next ruling that will surely stay
+        while (next + 1 < out.rulings.size() && isNew(next)) ++next;
+        if (!spaced(thinned.back(), r) || !spaced(r, out.rulings[next])) continue;
+      }
+      thinned.push_back(r);
+    }
+    out.rulings = std::move(thinned);
   }
   // Order along both chains.
   for (std::size_t k = 1; k < out.rulings.size(); ++k) {

@@ -365,4 +365,26 @@ void updateSamples(PhysicalMesh& p, const GeometricMesh& g, std::vector<Vec3>* v
   }
 }
 
+std::vector<double> sliverHingeFactors(const mesh::SheetMesh& sp,
+                                       const std::vector<mesh::MeshEdge>& hinges, double ratio) {
+  const auto area = [&](int t) {
+    const auto& tri = sp.triangles[static_cast<std::size_t>(t)];
+    const Vec2 a =
+        sp.pattern[static_cast<std::size_t>(tri[1])] - sp.pattern[static_cast<std::size_t>(tri[0])];
+    const Vec2 b =
+        sp.pattern[static_cast<std::size_t>(tri[2])] - sp.pattern[static_cast<std::size_t>(tri[0])];
+    return 0.5 * std::abs(a.x() * b.y() - a.y() * b.x());
+  };
+  std::vector<double> out(hinges.size(), 1.0);
+  for (std::size_t h = 0; h < hinges.size(); ++h) {
+    const mesh::MeshEdge& e = hinges[h];
+    if (!e.interior() || !(ratio > 0.0)) continue;
+    const double len2 = (sp.pattern[static_cast<std::size_t>(e.v[0])] -
+                         sp.pattern[static_cast<std::size_t>(e.v[1])])
+                            .squaredNorm();
+    out[h] = std::min(1.0, (area(e.triangles[0]) + area(e.triangles[1])) / len2 / ratio);
+  }
+  return out;
+}
+
 }  // namespace crumple::paper

@@ -1,6 +1,7 @@
 #include "crumple/paper/hybrid_sheet.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -15,6 +16,7 @@
 #include "crumple/paper/cone_fit.hpp"
 #include "crumple/paper/damage.hpp"
 #include "region_tools.hpp"
+#include "step_trace.hpp"
 
 namespace crumple::paper {
 
@@ -28,6 +30,36 @@ double msSince(Clock::time_point t0) {
 
 bool allFinite(const std::vector<Vec3>& v) {
   return std::all_of(v.begin(), v.end(), [](const Vec3& x) { return x.allFinite(); });
+}
+
+// Sums the stats of the animation steps of one frame.
+void accumulate(HybridStepStats& total, const HybridStepStats& s) {
+  total.elastic.newtonIterations += s.elastic.newtonIterations;
+  total.elastic.halvings += s.elastic.halvings;
+  total.elastic.solves += s.elastic.solves;
+  total.elastic.finalStepNorm = s.elastic.finalStepNorm;
+  GeometricStepStats& g = total.geometric;
+  const GeometricStepStats& h = s.geometric;
+  g.edgeFlips += h.edgeFlips;
+  g.flatSplits += h.flatSplits;
+  g.curvedCreated += h.curvedCreated;
+  g.singularInserted += h.singularInserted;
+  g.creases += h.creases;
+  g.junctionMoves += h.junctionMoves;
+  g.curvedFlattened += h.curvedFlattened;
+  g.maxCompression = std::max(g.maxCompression, h.maxCompression);
+  g.cuts.insert(g.cuts.end(), h.cuts.begin(), h.cuts.end());
+  g.notes.insert(g.notes.end(), h.notes.begin(), h.notes.end());
+  const int phaseOne = total.isometry.phaseOneIterations + s.isometry.phaseOneIterations;
+  total.isometry = s.isometry;  // the frame ends with the last step's projection
+  total.isometry.phaseOneIterations = phaseOne;
+  total.ms.elastic += s.ms.elastic;
+  total.ms.geometric += s.ms.geometric;
+  total.ms.cones += s.ms.cones;
+  total.ms.rebuild += s.ms.rebuild;
+  total.ms.isometry += s.ms.isometry;
+  total.coneSegments = s.coneSegments;
+  total.topologyChanged = total.topologyChanged || s.topologyChanged;
 }
 
 }  // namespace
@@ -83,13 +115,27 @@ struct HybridSheet::Impl {
     std::vector<double> angles(hinges.size());
     for (std::size_t h = 0; h < hinges.size(); ++h) angles[h] = elastic->hingeAngle(h);
     const auto damage = fiberDamage(sp.mesh, hinges, singular, angles, params);
+    const std::vector<double> sliver = sliverHingeFactors(sp.mesh, hinges, params.sliverHingeRatio);
     for (std::size_t h = 0; h < hinges.size(); ++h) {
       elastic->setHingeRestAngle(h, damage[h].restAngle);
-      elastic->setHingeStiffnessFactor(h, damage[h].stiffnessFactor);
+      elastic->setHingeStiffnessFactor(h, damage[h].stiffnessFactor * sliver[h]);
     }
     if (onRebuild) onRebuild(sp.mesh, time);
     return !same;
   }
+
+  // Developer trace (CRUMPLE_DEBUG_GEOMETRY, step_trace.hpp) and the largest
+  // S_P hinge angle after the elastic step, the rebuild and the isometry.
+  int traceLevel = detail::stepTraceLevel();
+  std::array<double, 3> traceHinge{};
+  void noteHinge(int stage) {
+    if (traceLevel > 0)
+      traceHinge[static_cast<std::size_t>(stage)] = detail::maxHingeAngle(*elastic);
+  }
+
+  void animationStep(double t, double dt, const sim::PinFunction& pins, int frame,
+                     int singularBudget, std::uint64_t& draw, HybridStepStats& stats,
+                     const char*& stage);
 
   void checkInvariants(int frame, const char* stage) const {
     const std::string problem = validate(sg, params.theta0);
@@ -126,6 +172,7 @@ HybridSheet::HybridSheet(GeometricMesh sg, const sim::Material& material,
   m.simParams = simParams;
   m.simParams.membraneScale = params.membraneScale;
   m.simParams.minVertexMassFraction = params.minVertexMassFraction;
+  m.simParams.newtonTolerance = params.newtonTolerance;
   m.params = params;
   m.seed = seed;
   for (const Vec2& a : m.sg.outline) {
@@ -176,6 +223,147 @@ int HybridSheet::interiorSingularVertexCount() const {
                     [](const GeometricVertex& v) { return v.singular && !v.onBoundary; }));
 }
 
+// One animation step of the paper (Fig. 16, thesis Algorithm 1) from t to
+// t + dt: an elastic step of S_P, S_P -> S_G, the geometric step, cone
+// fitting, S_P rebuilt from S_G and the isometry projection. `stage` names
+// the stage running, for the error message when it throws.
+void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunction& pins, int frame,
+                                      int singularBudget, std::uint64_t& draw,
+                                      HybridStepStats& stats, const char*& stage) {
+  Impl& m = *this;
+  CrumpleParams stepParams = m.params;
+  stepParams.maxSingularPerStep = singularBudget;
+  // (a)-(b) elastic relaxation of S_P with the handles as hard constraints.
+  stage = "elastic";
+  auto t0 = Clock::now();
+  stats.elastic = m.elastic->advance(t, dt, pins);
+  stats.ms.elastic = msSince(t0);
+  m.noteHinge(0);
+  const std::vector<Vec3>& x = m.elastic->positions();
+  const std::vector<Vec3>& v = m.elastic->velocities();
+  // (c) S_P -> S_G.
+  for (std::size_t i = 0; i < m.sg.vertices.size(); ++i) {
+    m.sg.vertices[i].position = x[i];
+    m.sg.vertices[i].velocity = v[i];
+  }
+  // (d)-(e) geometric step (thesis Algorithm 1).
+  stage = "geometric";
+  t0 = Clock::now();
+  const BoundaryCurve curve =
+      boundaryCurveFromMesh(m.sg, m.sp.mesh.pattern, x, 1e-9 * m.paperLength);
+  const BoundaryPosition boundary = [&curve](double s) { return curve.evaluate(s); };
+  // With invariant checks on, every sub-step is checked so a failure names it.
+  const auto checkAfter = [&](const char* step) {
+    if (!m.params.checkInvariants) return;
+    if (const std::string problem = validate(m.sg); !problem.empty()) {
+      throw NumericalError("geometric", frame,
+                           std::string("S_G invariant broken after ") + step + ": " + problem);
+    }
+  };
+  updateJunctions(m.sg, m.params, boundary, stats.geometric);
+  checkAfter("junction update");
+  stats.geometric.edgeFlips = flipCompressedEdges(m.sg, m.params);
+  checkAfter("edge flips");
+  mesh::SheetMesh bentSp = m.sp.mesh;  // S_P as the elastic step left it
+  bentSp.positions = x;
+  bendFoldedFlatRegions(m.sg, m.params, boundary, stats.geometric, &bentSp);
+  checkAfter("folded flat regions");
+  stats.geometric.flatSplits = splitFlatRegions(m.sg, m.params);
+  checkAfter("flat-region splits");
+  const CounterRng rng(m.seed, frame, RngPurpose::SingularityPlacement);
+  // Regions cut in the last remeshCooldown steps wait (the cooldown).
+  const FaceFilter settled = [&m](int face) {
+    return !m.holdsRecentCut(m.sg.faces[static_cast<std::size_t>(face)]);
+  };
+  treatCompression(m.sg, stepParams, boundary, rng, draw, stats.geometric, settled);
+  checkAfter("compression treatment");
+  treatCurvedCompression(m.sg, stepParams, rng, draw, stats.geometric, settled);
+  checkAfter("curved-region compression");
+  stats.ms.geometric = msSince(t0);
+  // (f) generalized cones (paper Sec. 6.2).
+  stage = "cones";
+  t0 = Clock::now();
+  for (std::size_t r = 0; r < m.sg.regions.size(); ++r) {
+    const Region& region = m.sg.regions[r];
+    if (region.type != mesh::RegionType::Curved || region.apex >= 0 || region.rulings.size() < 3)
+      continue;
+    const GeometricMesh before = m.sg;
+    const ConeRefitResult fit =
+        refitCurvedRegion(m.sg, static_cast<int>(r), curve, m.params, m.paperLength);
+    GeometricMesh compacted = m.sg;  // the fit leaves unused vertices for compact()
+    compact(compacted);
+    if (const std::string problem = validate(compacted); !problem.empty()) {
+      m.sg = before;  // transactional, like the other remeshing steps
+      stats.geometric.notes.push_back("cone fit of curved region " + std::to_string(r) +
+                                      " undone (" + problem + ")");
+      continue;
+    }
+    stats.coneSegments += fit.segmentCount;
+  }
+  compact(m.sg);
+  // Faces created by the remeshing are flat only when coplanar: regions are
+  // the maximal coplanar sets again before S_P is built.
+  splitFlatRegions(m.sg, m.params);
+  stats.ms.cones = msSince(t0);
+  for (const GeometricVertex& gv : m.sg.vertices) {
+    if (!gv.position.allFinite())
+      throw NumericalError("geometric", frame, "S_G vertex position is not finite");
+  }
+  if (m.params.checkInvariants) {
+    const std::string problem = validate(m.sg, m.params.theta0);
+    if (!problem.empty())
+      throw NumericalError("geometric", frame, "S_G invariant broken: " + problem);
+  }
+  m.time = t + dt;
+  // (g) S_P from S_G.
+  stage = "rebuild";
+  t0 = Clock::now();
+  stats.topologyChanged = m.rebuildPhysical();
+  m.noteHinge(1);
+  stats.ms.rebuild = msSince(t0);
+  if (m.params.checkInvariants) m.checkInvariants(frame, "geometric");
+  // (h) isometry with the handles fixed (paper Sec. 6.3).
+  stage = "isometry";
+  t0 = Clock::now();
+  std::vector<sim::Pin> pinned;
+  pins(t + dt, pinned);
+  std::vector<int> fixed;
+  for (const sim::Pin& p : pinned) fixed.push_back(p.vertex);
+  std::sort(fixed.begin(), fixed.end());
+  fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
+  if (!m.isometry || !m.isometry->sameTopology(m.sp.mesh.triangles, fixed) ||
+      static_cast<std::size_t>(m.isometry->vertexCount()) != m.sp.mesh.vertexCount() ||
+      stats.topologyChanged) {
+    IsometryOptions iso;
+    iso.rounds = m.params.isometryRounds;
+    m.isometry.emplace(m.sp.mesh.pattern, m.sp.mesh.triangles, fixed, iso);
+  }
+  std::vector<Vec3> positions = m.sp.mesh.positions;
+  stats.isometry = m.isometry->project(positions, m.params.isometryIterations);
+  if (!allFinite(positions)) throw NumericalError("isometry", frame, "non-finite positions");
+  if (stats.isometry.meanLengthErrorAfter > stats.isometry.meanLengthErrorBefore) {
+    // Never let the projection make lengths worse (it has no convergence
+    // guarantee, paper Sec. 6.3): keep the unprojected S_P then.
+    positions = m.sp.mesh.positions;
+    stats.isometry.meanLengthErrorAfter = stats.isometry.meanLengthErrorBefore;
+    stats.isometry.meanDisplacement = 0.0;
+  }
+  m.sp.mesh.positions = positions;
+  for (std::size_t i = 0; i < m.sg.vertices.size(); ++i) m.sg.vertices[i].position = positions[i];
+  m.elastic->setPositions(positions);
+  m.noteHinge(2);
+  for (auto& cut : m.recentCuts) --cut.second;
+  std::erase_if(m.recentCuts, [](const auto& cut) { return cut.second <= 0; });
+  for (const Vec2& p : stats.geometric.cuts) m.recentCuts.emplace_back(p, m.params.remeshCooldown);
+  stats.ms.isometry = msSince(t0);
+  if (m.traceLevel > 0) {
+    std::vector<sim::Pin> pinned;
+    pins(t + dt, pinned);
+    detail::printStepTrace(m.traceLevel, frame, m.sg, m.sp, *m.elastic, stats, pinned,
+                           m.traceHinge);
+  }
+}
+
 HybridStepStats HybridSheet::advance(double t, double dt, int substeps,
                                      const sim::PinFunction& pins, int frame) {
   Impl& m = *impl_;
@@ -186,154 +374,15 @@ HybridStepStats HybridSheet::advance(double t, double dt, int substeps,
   const std::vector<Vec3> vBefore = m.elastic->velocities();
   const char* stage = "elastic";
   try {
-    // (a)-(b) elastic relaxation of S_P with the handles as hard constraints.
-    auto t0 = Clock::now();
+    // The frame's substeps are the paper's animation steps; singular
+    // vertices appear at most maxSingularPerStep per frame.
     const int n = std::max(1, substeps);
-    for (int k = 0; k < n; ++k) {
-      const sim::StepStats s = m.elastic->advance(t + dt * k / n, dt / n, pins);
-      stats.elastic.newtonIterations += s.newtonIterations;
-      stats.elastic.halvings += s.halvings;
-      stats.elastic.solves += s.solves;
-      stats.elastic.finalStepNorm = s.finalStepNorm;
-    }
-    stats.ms.elastic = msSince(t0);
-    const std::vector<Vec3>& x = m.elastic->positions();
-    const std::vector<Vec3>& v = m.elastic->velocities();
-    // (c) S_P -> S_G.
-    for (std::size_t i = 0; i < m.sg.vertices.size(); ++i) {
-      m.sg.vertices[i].position = x[i];
-      m.sg.vertices[i].velocity = v[i];
-    }
-    // (d)-(e) geometric step (thesis Algorithm 1).
-    stage = "geometric";
-    t0 = Clock::now();
-    const BoundaryCurve curve =
-        boundaryCurveFromMesh(m.sg, m.sp.mesh.pattern, x, 1e-9 * m.paperLength);
-    const BoundaryPosition boundary = [&curve](double s) { return curve.evaluate(s); };
-    // With invariant checks on, every sub-step is checked so a failure names it.
-    const auto checkAfter = [&](const char* step) {
-      if (!m.params.checkInvariants) return;
-      if (const std::string problem = validate(m.sg); !problem.empty()) {
-        throw NumericalError("geometric", frame,
-                             std::string("S_G invariant broken after ") + step + ": " + problem);
-      }
-    };
-    updateJunctions(m.sg, m.params, boundary, stats.geometric);
-    checkAfter("junction update");
-    stats.geometric.edgeFlips = flipCompressedEdges(m.sg, m.params);
-    checkAfter("edge flips");
-    bendFoldedFlatRegions(m.sg, m.params, boundary, stats.geometric);
-    checkAfter("folded flat regions");
-    stats.geometric.flatSplits = splitFlatRegions(m.sg, m.params);
-    checkAfter("flat-region splits");
-    const CounterRng rng(m.seed, frame, RngPurpose::SingularityPlacement);
     std::uint64_t draw = 0;
-    // Regions cut in the last remeshCooldown steps wait (the cooldown).
-    const FaceFilter settled = [&m](int face) {
-      return !m.holdsRecentCut(m.sg.faces[static_cast<std::size_t>(face)]);
-    };
-    treatCompression(m.sg, m.params, boundary, rng, draw, stats.geometric, settled);
-    checkAfter("compression treatment");
-    treatCurvedCompression(m.sg, m.params, rng, draw, stats.geometric, settled);
-    checkAfter("curved-region compression");
-    stats.ms.geometric = msSince(t0);
-    // (f) generalized cones (paper Sec. 6.2).
-    stage = "cones";
-    t0 = Clock::now();
-    for (std::size_t r = 0; r < m.sg.regions.size(); ++r) {
-      const Region& region = m.sg.regions[r];
-      if (region.type != mesh::RegionType::Curved || region.apex >= 0 || region.rulings.size() < 3)
-        continue;
-      const GeometricMesh before = m.sg;
-      const ConeRefitResult fit =
-          refitCurvedRegion(m.sg, static_cast<int>(r), curve, m.params, m.paperLength);
-      GeometricMesh compacted = m.sg;  // the fit leaves unused vertices for compact()
-      compact(compacted);
-      if (const std::string problem = validate(compacted); !problem.empty()) {
-        m.sg = before;  // transactional, like the other remeshing steps
-        stats.geometric.notes.push_back("cone fit of curved region " + std::to_string(r) +
-                                        " undone (" + problem + ")");
-        continue;
-      }
-      stats.coneSegments += fit.segmentCount;
-    }
-    compact(m.sg);
-    // Faces created by the remeshing are flat only when coplanar: regions are
-    // the maximal coplanar sets again before S_P is built.
-    splitFlatRegions(m.sg, m.params);
-    stats.ms.cones = msSince(t0);
-    for (const GeometricVertex& gv : m.sg.vertices) {
-      if (!gv.position.allFinite())
-        throw NumericalError("geometric", frame, "S_G vertex position is not finite");
-    }
-    if (m.params.checkInvariants) {
-      const std::string problem = validate(m.sg, m.params.theta0);
-      if (!problem.empty())
-        throw NumericalError("geometric", frame, "S_G invariant broken: " + problem);
-    }
-    m.time = t + dt;
-    // (g) S_P from S_G.
-    stage = "rebuild";
-    t0 = Clock::now();
-    stats.topologyChanged = m.rebuildPhysical();
-    stats.ms.rebuild = msSince(t0);
-    if (m.params.checkInvariants) m.checkInvariants(frame, "geometric");
-    // (h) isometry with the handles fixed (paper Sec. 6.3).
-    stage = "isometry";
-    t0 = Clock::now();
-    std::vector<sim::Pin> pinned;
-    pins(t + dt, pinned);
-    std::vector<int> fixed;
-    for (const sim::Pin& p : pinned) fixed.push_back(p.vertex);
-    std::sort(fixed.begin(), fixed.end());
-    fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
-    if (!m.isometry || !m.isometry->sameTopology(m.sp.mesh.triangles, fixed) ||
-        static_cast<std::size_t>(m.isometry->vertexCount()) != m.sp.mesh.vertexCount() ||
-        stats.topologyChanged) {
-      IsometryOptions iso;
-      iso.rounds = m.params.isometryRounds;
-      m.isometry.emplace(m.sp.mesh.pattern, m.sp.mesh.triangles, fixed, iso);
-    }
-    std::vector<Vec3> positions = m.sp.mesh.positions;
-    stats.isometry = m.isometry->project(positions, m.params.isometryIterations);
-    if (!allFinite(positions)) throw NumericalError("isometry", frame, "non-finite positions");
-    if (stats.isometry.meanLengthErrorAfter > stats.isometry.meanLengthErrorBefore) {
-      // Never let the projection make lengths worse (it has no convergence
-      // guarantee, paper Sec. 6.3): keep the unprojected S_P then.
-      positions = m.sp.mesh.positions;
-      stats.isometry.meanLengthErrorAfter = stats.isometry.meanLengthErrorBefore;
-      stats.isometry.meanDisplacement = 0.0;
-    }
-    m.sp.mesh.positions = positions;
-    for (std::size_t i = 0; i < m.sg.vertices.size(); ++i) m.sg.vertices[i].position = positions[i];
-    m.elastic->setPositions(positions);
-    for (auto& cut : m.recentCuts) --cut.second;
-    std::erase_if(m.recentCuts, [](const auto& cut) { return cut.second <= 0; });
-    for (const Vec2& p : stats.geometric.cuts)
-      m.recentCuts.emplace_back(p, m.params.remeshCooldown);
-    stats.ms.isometry = msSince(t0);
-    if (const char* env = std::getenv("CRUMPLE_DEBUG_GEOMETRY"); env != nullptr && env[0] == '1') {
-      // Developer trace of the geometric step, one line per frame.
-      int curved = 0;
-      for (const Region& r : m.sg.regions) curved += r.type == mesh::RegionType::Curved ? 1 : 0;
-      const GeometricStepStats& gs = stats.geometric;
-      std::fprintf(stderr,
-                   "[geometry] frame %d: S_G %zu v %zu f %zu regions (%d curved), S_P %zu tris; "
-                   "flips %d splits %d "
-                   "curved+ %d singular+ %d creases %d junction %d flattened %d cmax %.4f; c_mean "
-                   "%.2e -> %.2e\n",
-                   frame, m.sg.vertices.size(), m.sg.faces.size(), m.sg.regions.size(), curved,
-                   m.sp.mesh.triangleCount(), gs.edgeFlips, gs.flatSplits, gs.curvedCreated,
-                   gs.singularInserted, gs.creases, gs.junctionMoves, gs.curvedFlattened,
-                   gs.maxCompression, stats.isometry.meanLengthErrorBefore,
-                   stats.isometry.meanLengthErrorAfter);
-      double vmax = 0.0;
-      for (const Vec3& vv : m.elastic->velocities()) vmax = std::max(vmax, vv.norm());
-      std::fprintf(stderr,
-                   "[geometry]   max speed %.3g m/s, isometry displacement %.3g m, halvings %d\n",
-                   vmax, stats.isometry.meanDisplacement, stats.elastic.halvings);
-      for (const std::string& note : gs.notes)
-        std::fprintf(stderr, "[geometry]   %s\n", note.c_str());
+    for (int k = 0; k < n; ++k) {
+      HybridStepStats s;
+      const int budget = m.params.maxSingularPerStep - stats.geometric.singularInserted;
+      m.animationStep(t + dt * k / n, dt / n, pins, frame, std::max(0, budget), draw, s, stage);
+      accumulate(stats, s);
     }
   } catch (const std::exception& e) {
     if (const char* dump = std::getenv("CRUMPLE_DEBUG_DUMP"); dump != nullptr) {

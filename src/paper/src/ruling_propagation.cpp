@@ -7,11 +7,14 @@
 // strip of Appendix A is the run of chords around the compressed triangle
 // that go from dS to dS without meeting a constrained border or a vertex
 // that is not on dS; its extreme chords are r_lim1 and r_lim2 (Appendix B).
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <map>
 #include <numbers>
 #include <optional>
+#include <span>
 #include <sstream>
 
 #include "crumple/mesh/delaunay.hpp"
@@ -134,7 +137,13 @@ struct Context {
 
 // The chord at `param` if it runs from dS to dS (or from the apex to dS)
 // through the region without touching a constrained border, else nullopt.
-std::optional<Chord> evaluateChord(const Context& c, const Pencil& pencil, double param) {
+std::optional<Chord> evaluateChord(const Context& c, const Pencil& pencil, double param,
+                                   const char** why = nullptr) {
+  // Returns no chord, saying why when asked (for the remeshing notes).
+  const auto fail = [why](const char* reason) -> std::optional<Chord> {
+    if (why != nullptr) *why = reason;
+    return std::nullopt;
+  };
   const PencilFrame line = chordLine(c.g, pencil, param);
   auto hits = crossings(c.g, c.loop, line, c.tol);
   const auto endOk = [&](const ChordEnd& e) {
@@ -147,10 +156,10 @@ std::optional<Chord> evaluateChord(const Context& c, const Pencil& pencil, doubl
     // The chord through `origin`-side: the pair of consecutive hits whose
     // midpoint is inside the region and closest to the pencil's origin line.
     // With a simple region the valid chord has exactly two hits.
-    if (hits.size() != 2) return std::nullopt;
+    if (hits.size() != 2) return fail("the chord crosses the region's border more than twice");
     chord.a = hits[0].second;
     chord.b = hits[1].second;
-    if (!endOk(chord.a) || !endOk(chord.b)) return std::nullopt;
+    if (!endOk(chord.a) || !endOk(chord.b)) return fail("the chord ends on a constrained border");
   } else {
     // From the apex forwards to the first hit that is not the apex itself.
     const int apexLoop = static_cast<int>(std::find(c.loop.v.begin(), c.loop.v.end(), pencil.apex) -
@@ -166,7 +175,8 @@ std::optional<Chord> evaluateChord(const Context& c, const Pencil& pencil, doubl
       first = e;
       break;
     }
-    if (!first || !endOk(*first)) return std::nullopt;
+    if (!first) return fail("the chord from the apex leaves the region at once");
+    if (!endOk(*first)) return fail("the chord from the apex ends on a constrained border");
     chord.a.p = line.point;
     chord.a.vertex = apexLoop;
     chord.b = *first;
@@ -178,11 +188,14 @@ std::optional<Chord> evaluateChord(const Context& c, const Pencil& pencil, doubl
     const int i = chord.a.vertex;
     const int j = chord.b.vertex;
     if ((i + 1) % m == j)
-      return loopEdgeOnBoundary(c.loop, i) ? std::optional<Chord>(chord) : std::nullopt;
+      return loopEdgeOnBoundary(c.loop, i) ? std::optional<Chord>(chord)
+                                           : fail("the chord runs along a constrained border");
     if ((j + 1) % m == i)
-      return loopEdgeOnBoundary(c.loop, j) ? std::optional<Chord>(chord) : std::nullopt;
+      return loopEdgeOnBoundary(c.loop, j) ? std::optional<Chord>(chord)
+                                           : fail("the chord runs along a constrained border");
   }
-  if (!insideLoop(c.g, c.loop, 0.5 * (chord.a.p + chord.b.p))) return std::nullopt;
+  if (!insideLoop(c.g, c.loop, 0.5 * (chord.a.p + chord.b.p)))
+    return fail("the chord runs outside the region");
   // No vertex of the region may lie on the chord (a singular or handle
   // vertex inside the strip, Appendix B: "no singular point inside").
   const Vec2 d = chord.b.p - chord.a.p;
@@ -192,7 +205,7 @@ std::optional<Chord> evaluateChord(const Context& c, const Pencil& pencil, doubl
     const double t = (p - chord.a.p).dot(d) / len2;
     if (t > 0.0 && t < 1.0 &&
         std::abs(cross2(d, p - chord.a.p)) / std::sqrt(len2) <= 10.0 * c.tol) {
-      return std::nullopt;
+      return fail("a vertex inside the region lies on the chord");
     }
   }
   return chord;
@@ -200,7 +213,8 @@ std::optional<Chord> evaluateChord(const Context& c, const Pencil& pencil, doubl
 
 // Appendix A-B: the run of valid chords around parameter 0, bounded by the
 // extreme rulings r_lim1 and r_lim2. Returns the sorted chord parameters.
-std::vector<double> stripParameters(const Context& c, const Pencil& pencil, double spacing) {
+std::vector<double> stripParameters(const Context& c, const Pencil& pencil, double spacing,
+                                    const char** why = nullptr) {
   std::vector<double> events;
   const auto addEvent = [&](int v) {
     if (v == pencil.apex) return;
@@ -221,7 +235,10 @@ std::vector<double> stripParameters(const Context& c, const Pencil& pencil, doub
   const auto intervalValid = [&](std::size_t i) {
     return evaluateChord(c, pencil, 0.5 * (events[i] + events[i + 1])).has_value();
   };
-  if (!intervalValid(i0)) return {};
+  if (!intervalValid(i0)) {
+    evaluateChord(c, pencil, 0.5 * (events[i0] + events[i0 + 1]), why);
+    return {};
+  }
   const auto eventOk = [&](double param) { return evaluateChord(c, pencil, param).has_value(); };
   // Extend up.
   std::size_t hiInterval = i0;
@@ -468,9 +485,12 @@ StripResult remeshStrip(GeometricMesh& g, int region, const Pencil& pencil,
   }
   const double scale = std::sqrt(outlineArea(g));
   const Context ctx{g, loop, interior, 1e-10 * scale};
-  const std::vector<double> stripParams = stripParameters(ctx, pencil, 1.0 / params.rhoBound);
+  const char* noStrip = "";
+  const std::vector<double> stripParams =
+      stripParameters(ctx, pencil, 1.0 / params.rhoBound, &noStrip);
   if (stripParams.size() < 2)
-    return {false, "no strip of free rulings around the compressed triangle"};
+    return {false, std::string("no strip of free rulings around the compressed triangle (") +
+                       noStrip + ")"};
   std::vector<Chord> chords;
   for (double p : stripParams) {
     auto c = evaluateChord(ctx, pencil, p);
@@ -482,6 +502,66 @@ StripResult remeshStrip(GeometricMesh& g, int region, const Pencil& pencil,
   const double width = std::max((chords.back().a.p - chords.front().a.p).norm(),
                                 (chords.back().b.p - chords.front().b.p).norm());
   if (width < 0.1 / params.rhoBound) return {false, "strip too narrow"};
+  // Ruling ends at least half the ruling spacing apart on both borders (or
+  // one shared vertex, a fan's apex): a conical pencil spaced at 1/rho_bound
+  // on its far border crowds its near border, and ends millimetres apart
+  // make sliver cells that stall the elastic solve. The limit rulings stay.
+  // Chord ends within a quarter of the ruling spacing of a loop vertex move
+  // onto it (a new vertex beside an existing one would make slivers); a chord
+  // that then runs along part of a loop edge is no ruling and is dropped.
+  {
+    const double snap = 0.25 / params.rhoBound;
+    const int m = static_cast<int>(loop.size());
+    const auto snapEnd = [&](ChordEnd& e) {
+      if (e.vertex >= 0) return;
+      const int a = e.loopEdge;
+      const int b = (a + 1) % m;
+      for (int k : {a, b}) {
+        const Vec2& p =
+            g.vertices[static_cast<std::size_t>(loop.v[static_cast<std::size_t>(k)])].pattern;
+        if ((e.p - p).norm() < snap) {
+          e.p = p;
+          e.vertex = k;
+          e.loopEdge = -1;
+          return;
+        }
+      }
+    };
+    const auto alongLoop = [&](const ChordEnd& x, const ChordEnd& y) {
+      if (x.loopEdge >= 0 && y.loopEdge >= 0) return x.loopEdge == y.loopEdge;
+      const ChordEnd& onEdge = x.loopEdge >= 0 ? x : y;
+      const ChordEnd& atVertex = x.loopEdge >= 0 ? y : x;
+      if (onEdge.loopEdge < 0) return false;  // both at vertices: handled by evaluateChord
+      return atVertex.vertex == onEdge.loopEdge || atVertex.vertex == (onEdge.loopEdge + 1) % m;
+    };
+    std::vector<Chord> kept;
+    for (Chord c : chords) {
+      snapEnd(c.a);
+      snapEnd(c.b);
+      if (c.a.vertex >= 0 && c.a.vertex == c.b.vertex) continue;
+      if (alongLoop(c.a, c.b)) continue;
+      kept.push_back(c);
+    }
+    chords = std::move(kept);
+    if (chords.size() < 2) return {false, "strip has fewer than two distinct rulings"};
+  }
+  {
+    const double minGap = 0.5 / params.rhoBound;
+    const auto apart = [&](const ChordEnd& x, const ChordEnd& y) {
+      const double d = (x.p - y.p).norm();
+      return d < ctx.tol || d >= minGap;
+    };
+    const auto spaced = [&](const Chord& x, const Chord& y) {
+      return apart(x.a, y.a) && apart(x.b, y.b);
+    };
+    std::vector<Chord> kept{chords.front()};
+    for (std::size_t k = 1; k + 1 < chords.size(); ++k) {
+      if (spaced(kept.back(), chords[k]) && spaced(chords[k], chords.back()))
+        kept.push_back(chords[k]);
+    }
+    if (chords.size() > 1) kept.push_back(chords.back());
+    chords = std::move(kept);
+  }
 
   // Vertices for the chord ends: existing loop vertices, or new ones on dS
   // edges (several per edge are kept in order along it).
@@ -493,8 +573,9 @@ StripResult remeshStrip(GeometricMesh& g, int region, const Pencil& pencil,
     const Vec2& pa = g.vertices[static_cast<std::size_t>(a)].pattern;
     const Vec2& pb = g.vertices[static_cast<std::size_t>(b)].pattern;
     const double u = (e.p - pa).norm() / (pb - pa).norm();
-    // Snap onto an endpoint closer than a fiftieth of the ruling spacing.
-    const double snap = 0.02 / params.rhoBound;
+    // Snap onto an endpoint closer than a quarter of the ruling spacing (a
+    // new vertex beside an existing one would make sliver triangles).
+    const double snap = 0.25 / params.rhoBound;
     if ((e.p - pa).norm() < snap) return a;
     if ((e.p - pb).norm() < snap) return b;
     const int v = addBoundaryVertex(g, a, b, e.p, boundary);
@@ -632,6 +713,16 @@ bool splitAlongCrease(GeometricMesh& g, int region, int s1, int s2) {
   return true;
 }
 
+// Whether a new vertex at pattern point p would sit closer than a quarter of
+// the ruling spacing to an existing S_G vertex: S_P triangles that small
+// (tens of micrometres when d-cones pile up) make the elastic system too
+// ill-conditioned to factor, so such an insertion is declined.
+bool crowded(const GeometricMesh& g, const Vec2& p, const CrumpleParams& params) {
+  const double gap = 0.25 / params.rhoBound;
+  return std::any_of(g.vertices.begin(), g.vertices.end(),
+                     [&](const GeometricVertex& v) { return (v.pattern - p).norm() < gap; });
+}
+
 // paper Sec. 5.2 (flat-flat case): the singular vertex goes on the border
 // edge itself, near where the imaginary ruling meets it, spread along the
 // edge with the law exp(-d^2/sigma^2) and kept off its ends.
@@ -646,6 +737,7 @@ int placeSingularOnBorder(GeometricMesh& g, const Loop& loop, const Border& bord
   const double u0 = (border.hit - pa).norm() / len;
   const double shift = normalDeviate(rng, drawIndex) * params.sigma / std::sqrt(2.0);
   const double u = std::clamp(u0 + shift / len, 0.15, 0.85);
+  if (crowded(g, pa + u * (pb - pa), params)) return -1;
   return insertSingularOnEdge(g, a, b, pa + u * (pb - pa));
 }
 
@@ -738,6 +830,7 @@ int insertSingularInCurved(GeometricMesh& g, int flat, const Loop& loop, const B
     cell = ksing < n ? ksing : n - 1;
     if (!inCell(cell, s)) cell = ksing > 0 ? ksing - 1 : 0;
   }
+  if (crowded(g, s, params)) return -1;
   // 3D position of s: barycentric in the cell's triangle holding it.
   std::optional<GeometricVertex> placed = vertexInCell(g, rulings[cell], rulings[cell + 1], s);
   if (!placed) return -1;
@@ -825,7 +918,7 @@ void treatCurvedCompression(GeometricMesh& g, const CrumpleParams& params, const
       }
     }
     stats.maxCompression = std::max(stats.maxCompression, cmax);
-    if (kmax == 0 || !(cmax > params.epsC)) continue;
+    if (kmax == 0 || !(cmax > params.curvedCompressionFactor * params.epsC)) continue;
     const std::size_t n = rulings.size() - 1;
     const Vec2 sa = P(rulings[kmax].a);
     const Vec2 sb = P(rulings[kmax].b);
@@ -841,6 +934,7 @@ void treatCurvedCompression(GeometricMesh& g, const CrumpleParams& params, const
     const double d = std::clamp(across, -0.5 * wBwd, 0.5 * wFwd);
     const Vec2 s = sa + along * (sb - sa) + d * normal;
     std::size_t cell = d >= 0.0 ? kmax : kmax - 1;
+    if (crowded(g, s, params)) continue;
     // 3D position: barycentric in the cell's triangle holding s.
     std::optional<GeometricVertex> placed = vertexInCell(g, rulings[cell], rulings[cell + 1], s);
     if (!placed) continue;
@@ -916,9 +1010,65 @@ namespace {}  // namespace
 // strip of rulings parallel to the folded edge (its direction is the
 // direction of zero curvature); only when that strip meets a constrained
 // border is the region split along the edge as in thesis Fig. 2.5.
+namespace {
+
+// How S_P bends inside flat region r of S_G: the principal direction of
+// sum theta^2 e e^T over S_P hinges whose pattern midpoint lies in r (e the
+// hinge's unit pattern direction), and the midpoint of the most bent hinge.
+// nullopt when no hinge there bends by more than theta_0 / 2.
+std::optional<std::pair<Vec2, Vec2>> bendingDirection(const GeometricMesh& g, int r,
+                                                      const mesh::SheetMesh& sp,
+                                                      const std::vector<mesh::MeshEdge>& edges,
+                                                      double theta0) {
+  Eigen::Matrix2d tensor = Eigen::Matrix2d::Zero();
+  double most = 0.5 * theta0;
+  Vec2 origin = Vec2::Zero();
+  const auto normal = [&](int t) {
+    const auto& tri = sp.triangles[static_cast<std::size_t>(t)];
+    const Vec3& a = sp.positions[static_cast<std::size_t>(tri[0])];
+    return Vec3((sp.positions[static_cast<std::size_t>(tri[1])] - a)
+                    .cross(sp.positions[static_cast<std::size_t>(tri[2])] - a)
+                    .normalized());
+  };
+  for (const mesh::MeshEdge& e : edges) {
+    if (!e.interior()) continue;
+    const Vec2& pa = sp.pattern[static_cast<std::size_t>(e.v[0])];
+    const Vec2& pb = sp.pattern[static_cast<std::size_t>(e.v[1])];
+    const Vec2 mid = 0.5 * (pa + pb);
+    bool inside = false;
+    for (const GeometricFace& f : g.faces) {
+      if (f.region != r) continue;
+      if (detail::pointInPolygon(g, std::span<const int>(f.v.data(), f.size()), mid)) {
+        inside = true;
+        break;
+      }
+    }
+    if (!inside) continue;
+    const double theta =
+        std::acos(std::clamp(normal(e.triangles[0]).dot(normal(e.triangles[1])), -1.0, 1.0));
+    if (!std::isfinite(theta)) continue;
+    const Vec2 dir = (pb - pa).normalized();
+    tensor += theta * theta * dir * dir.transpose();
+    if (theta > most) {
+      most = theta;
+      origin = mid;
+    }
+  }
+  if (!(most > 0.5 * theta0)) return std::nullopt;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(tensor);
+  const Vec2 dir = eig.eigenvectors().col(1);  // largest eigenvalue last
+  if (!dir.allFinite()) return std::nullopt;
+  return std::pair{origin, dir};
+}
+
+}  // namespace
+
 int bendFoldedFlatRegions(GeometricMesh& g, const CrumpleParams& params,
-                          const BoundaryPosition& boundary, GeometricStepStats& stats) {
+                          const BoundaryPosition& boundary, GeometricStepStats& stats,
+                          const mesh::SheetMesh* sp) {
   int bent = 0;
+  const std::vector<mesh::MeshEdge> spEdges =
+      sp != nullptr ? mesh::buildEdges(*sp) : std::vector<mesh::MeshEdge>{};
   const std::size_t regionCount = g.regions.size();
   for (std::size_t r = 0; r < regionCount; ++r) {
     if (g.regions[r].type != mesh::RegionType::Flat) continue;
@@ -940,22 +1090,47 @@ int bendFoldedFlatRegions(GeometricMesh& g, const CrumpleParams& params,
     if (fold.first < 0) continue;
     const Vec2 a = g.vertices[static_cast<std::size_t>(fold.first)].pattern;
     const Vec2 b = g.vertices[static_cast<std::size_t>(fold.second)].pattern;
-    Pencil pencil;
-    pencil.origin = 0.5 * (a + b);
-    pencil.dir = (b - a).normalized();
+    // Candidate pencils, most faithful first: how S_P bends (through its
+    // most bent hinge, then through the fold), the folded S_G edge, and the
+    // directions of the rulings bounding the region (a flat gap between two
+    // curved strips bends like them).
+    std::vector<Pencil> candidates;
+    const Vec2 foldMid = 0.5 * (a + b);
+    if (sp != nullptr) {
+      if (const auto bend = bendingDirection(g, static_cast<int>(r), *sp, spEdges, params.theta0)) {
+        candidates.push_back({-1, bend->first, bend->second});
+        candidates.push_back({-1, foldMid, bend->second});
+      }
+    }
+    candidates.push_back({-1, foldMid, (b - a).normalized()});
+    if (const auto loop = regionLoop(g, static_cast<int>(r), edges)) {
+      for (std::size_t k = 0; k < loop->size(); ++k) {
+        const int across = loop->across[k];
+        if (across < 0 ||
+            g.regions[static_cast<std::size_t>(g.faces[static_cast<std::size_t>(across)].region)]
+                    .type != mesh::RegionType::Curved)
+          continue;
+        const Vec2 d = g.vertices[static_cast<std::size_t>(loop->next(k))].pattern -
+                       g.vertices[static_cast<std::size_t>(loop->v[k])].pattern;
+        if (d.norm() > 0.0) candidates.push_back({-1, foldMid, d.normalized()});
+      }
+    }
     const GeometricMesh before = g;
     StripResult result;
-    try {
-      result = remeshStrip(g, static_cast<int>(r), pencil, params, boundary);
-    } catch (const std::exception& e) {
-      g = before;
-      result = {false, e.what()};
-    }
-    if (result.done) {
-      if (const std::string problem = validate(g); !problem.empty()) {
+    for (const Pencil& pencil : candidates) {
+      try {
+        result = remeshStrip(g, static_cast<int>(r), pencil, params, boundary);
+      } catch (const std::exception& e) {
         g = before;
-        result = {false, "remeshing undone (" + problem + ")"};
+        result = {false, e.what()};
       }
+      if (result.done) {
+        if (const std::string problem = validate(g); !problem.empty()) {
+          g = before;
+          result = {false, "remeshing undone (" + problem + ")"};
+        }
+      }
+      if (result.done) break;
     }
     if (result.done) {
       ++bent;
@@ -1061,7 +1236,6 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
         }
         // (c) remesh: c1 with both borders free, c2 with singular vertices.
         const auto constrained = [](const Border& b) { return b.kind != Border::Kind::Free; };
-        int singular[2] = {-1, -1};
         const Border* borders[2] = {&bwd, &fwd};
         // Singular vertices on constrained borders (paper Sec. 5.2). A border
         // ruling of a curved region gets its singular vertex on the ruling
@@ -1069,6 +1243,8 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
         // A border ruling of a cone from a singular vertex s: the strip's
         // rulings are attracted by s itself (Appendix B, Fig. 24 b), no new
         // singular vertex is needed.
+        StripResult result;
+        int singular[2] = {-1, -1};
         bool feasible = true;
         int existingApex[2] = {-1, -1};
         for (int side = 0; side < 2; ++side) {
@@ -1135,6 +1311,7 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
             if (singular[side] < 0) break;
           } else {
             singular[side] = placeSingularOnBorder(g, *l2, b, params, rng, drawIndex);
+            if (singular[side] < 0) break;
           }
           ++stats.singularInserted;
         }
@@ -1144,22 +1321,43 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
           declined[r] = 1;
           continue;
         }
-        StripResult result;
+        // Rulings fanning from the apex on `side`: aimed where the strip
+        // meets the other border (free there by construction), else through
+        // the compressed triangle.
+        const auto coneFrom = [&](int apex, int side) {
+          Pencil pencil;
+          pencil.apex = apex;
+          const Vec2 s = g.vertices[static_cast<std::size_t>(apex)].pattern;
+          pencil.origin = s;
+          StripResult out{false, "no pencil"};
+          for (const Vec2& target : {borders[1 - side]->hit, centroid}) {
+            if (!((target - s).norm() > tol)) continue;
+            pencil.dir = (target - s).normalized();
+            out = remeshStrip(g, static_cast<int>(r), pencil, params, boundary);
+            if (out.done) break;
+          }
+          return out;
+        };
         if (singular[0] >= 0 && singular[1] >= 0) {
           result.done = splitAlongCrease(g, static_cast<int>(r), singular[0], singular[1]);
           if (result.done) ++stats.creases;
+          // Two existing apices that are one vertex, or already joined by a
+          // border edge, leave no crease to cut: the strip's rulings fan
+          // from one of them instead (Appendix B, Fig. 24 b).
+          for (int side = 0; side < 2 && !result.done; ++side) {
+            if (existingApex[side] < 0) continue;
+            result = coneFrom(existingApex[side], side);
+            if (result.done) ++stats.curvedCreated;
+          }
         } else {
-          Pencil pencil;
           if (singular[0] >= 0 || singular[1] >= 0) {
-            pencil.apex = singular[0] >= 0 ? singular[0] : singular[1];
-            const Vec2 s = g.vertices[static_cast<std::size_t>(pencil.apex)].pattern;
-            pencil.origin = s;
-            pencil.dir = (centroid - s).normalized();
+            result = singular[0] >= 0 ? coneFrom(singular[0], 0) : coneFrom(singular[1], 1);
           } else {
+            Pencil pencil;
             pencil.origin = centroid;
             pencil.dir = best.vPerp;
+            result = remeshStrip(g, static_cast<int>(r), pencil, params, boundary);
           }
-          result = remeshStrip(g, static_cast<int>(r), pencil, params, boundary);
           if (result.done) ++stats.curvedCreated;
         }
         if (!result.done) {

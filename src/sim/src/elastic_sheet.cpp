@@ -56,6 +56,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <mutex>
+#include <numbers>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
@@ -168,6 +169,12 @@ struct ElasticSheet::Impl {
   std::vector<double> hingeBase;                  // hingeStiffness(D, 1, ...)
   std::vector<double> hingeFactor;
   std::vector<double> hingeRest;
+  // Continuous (unwrapped) dihedral angle of each hinge at the last accepted
+  // state: atan2 wraps at +-pi, which would make a hinge folded past pi
+  // (sheets pass through themselves without contacts) jump to the other
+  // branch and the energy's gradient flip sign; angles are measured on the
+  // branch nearest to this one instead.
+  std::vector<double> hingeBranch;
   std::vector<double> mass;  // lumped, kg
   std::vector<char> active;  // vertex belongs to a triangle
   double typicalEdge = 0.0;  // mean pattern edge length (m)
@@ -208,6 +215,30 @@ struct ElasticSheet::Impl {
   bool stepRecursive(double t0, double t1, const PinFunction& pins, int depth, StepStats& stats,
                      std::string& why);
   double hingeStiffnessOf(std::size_t k) const { return hingeBase[k] * hingeFactor[k]; }
+  // The raw (wrapped) dihedral angle of hinge k at xs.
+  double rawAngle(std::size_t k, const std::vector<Vec3>& xs) const {
+    const auto& h = hingeVertices[k];
+    return dihedralAngle(xs[static_cast<std::size_t>(h[0])], xs[static_cast<std::size_t>(h[1])],
+                         xs[static_cast<std::size_t>(h[2])], xs[static_cast<std::size_t>(h[3])]);
+  }
+  // Hinge k's angle at xs on the branch nearest to hingeBranch[k].
+  double continuousAngle(std::size_t k, const std::vector<Vec3>& xs) const {
+    const double raw = rawAngle(k, xs);
+    return hingeBranch[k] + std::remainder(raw - hingeBranch[k], 2.0 * std::numbers::pi);
+  }
+  // The rest angle that, used with the raw angle at xs, gives the energy of
+  // the continuous angle: k (theta_cont - rest)^2 = k (theta_raw - rest')^2.
+  double branchRest(std::size_t k, const std::vector<Vec3>& xs) const {
+    const double raw = rawAngle(k, xs);
+    const double cont =
+        hingeBranch[k] + std::remainder(raw - hingeBranch[k], 2.0 * std::numbers::pi);
+    return hingeRest[k] - (cont - raw);
+  }
+  // Moves every hinge's branch to its angle at xs (after an accepted step
+  // or a teleport by the caller).
+  void trackBranches(const std::vector<Vec3>& xs) {
+    for (std::size_t k = 0; k < hingeVertices.size(); ++k) hingeBranch[k] = continuousAngle(k, xs);
+  }
 };
 
 ElasticSheet::Impl::Impl(const mesh::SheetMesh& m, const Material& material, const SimParams& p)
@@ -289,6 +320,8 @@ ElasticSheet::Impl::Impl(const mesh::SheetMesh& m, const Material& material, con
   typicalEdge = edges.empty() ? 1.0 : edgeSum / static_cast<double>(edges.size());
   hingeFactor.assign(hinges.size(), 1.0);
   hingeRest.assign(hinges.size(), 0.0);
+  hingeBranch.assign(hinges.size(), 0.0);
+  trackBranches(m.positions);
 
   triEnergy.assign(triangles.size(), 0.0);
   triTrial.assign(triangles.size(), 0.0);
@@ -432,12 +465,13 @@ void ElasticSheet::Impl::evaluate(const std::vector<Vec3>& xs, bool derivatives,
             const Vec3& p1 = xs[static_cast<std::size_t>(h[1])];
             const Vec3& p2 = xs[static_cast<std::size_t>(h[2])];
             const Vec3& p3 = xs[static_cast<std::size_t>(h[3])];
+            const double rest = branchRest(k, xs);
             if (!derivatives) {
-              hingeEnergy[k] = sim::bendingEnergy(p0, p1, p2, p3, stiffness, hingeRest[k]);
+              hingeEnergy[k] = sim::bendingEnergy(p0, p1, p2, p3, stiffness, rest);
               continue;
             }
-            hingeEnergy[k] = sim::bendingEnergy(p0, p1, p2, p3, stiffness, hingeRest[k],
-                                                &hingeGrad[k], &hingeHess[k]);
+            hingeEnergy[k] =
+                sim::bendingEnergy(p0, p1, p2, p3, stiffness, rest, &hingeGrad[k], &hingeHess[k]);
             if (project) projectToPsd(hingeHess[k]);
           }
         }
@@ -483,7 +517,7 @@ void ElasticSheet::Impl::evaluateEnergies(const std::vector<Vec3>& xs) {
                                                      xs[static_cast<std::size_t>(h[1])],
                                                      xs[static_cast<std::size_t>(h[2])],
                                                      xs[static_cast<std::size_t>(h[3])], stiffness,
-                                                     hingeRest[k]);
+                                                     branchRest(k, xs));
           }
         }
       },
@@ -607,7 +641,9 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
     }
     solver.factorize(matrix);
     ++stats.solves;
+    bool projected = false;
     if (solver.info() != Eigen::Success) {
+      projected = true;
       // Indefinite (compressed membrane, bent hinges): project every element
       // block to PSD; with the positive mass term the system is then SPD.
       projectHessians();
@@ -681,6 +717,13 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
       }
     }
     if (!accepted) {
+      // Within a hundred tolerances of the solution the energy decrease of
+      // the Newton step is below Phi's rounding: the iterate is as converged
+      // as the arithmetic allows.
+      if (stepNorm <= 100.0 * tol) {
+        converged = true;
+        break;
+      }
       why = "line search found no decrease";
       return false;
     }
@@ -695,8 +738,9 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
         }
       }
       std::fprintf(
-          stderr, "[newton] h %.3g it %d step %.3e s %.3g worst v %zu mass %.3g (mean %.3g)\n", h,
-          it, stepNorm, s, worst, mass[worst], std::accumulate(mass.begin(), mass.end(), 0.0) / nv);
+          stderr, "[newton] h %.3g it %d step %.3e s %.3g worst v %zu mass %.3g (mean %.3g)%s\n", h,
+          it, stepNorm, s, worst, mass[worst], std::accumulate(mass.begin(), mass.end(), 0.0) / nv,
+          projected ? " projected" : "");
     }
     xk.swap(xTrial);
   }
@@ -715,6 +759,7 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
     v[i] = (xk[i] - xn[i]) / h;
     x[i] = xk[i];
   }
+  trackBranches(x);
   return true;
 }
 
@@ -760,10 +805,8 @@ double ElasticSheet::hingeStiffnessFactor(std::size_t hinge) const {
   return impl_->hingeFactor.at(hinge);
 }
 double ElasticSheet::hingeAngle(std::size_t hinge) const {
-  const auto& h = impl_->hingeVertices.at(hinge);
-  const auto& x = impl_->x;
-  return dihedralAngle(x[static_cast<std::size_t>(h[0])], x[static_cast<std::size_t>(h[1])],
-                       x[static_cast<std::size_t>(h[2])], x[static_cast<std::size_t>(h[3])]);
+  if (hinge >= impl_->hingeVertices.size()) throw std::out_of_range("ElasticSheet::hingeAngle");
+  return impl_->continuousAngle(hinge, impl_->x);
 }
 
 StepStats ElasticSheet::advance(double t, double dt, const PinFunction& pins) {
@@ -799,6 +842,7 @@ void ElasticSheet::setPositions(const std::vector<Vec3>& x) {
     throw std::invalid_argument("ElasticSheet::setPositions: wrong vertex count");
   if (!finite(x)) throw std::invalid_argument("ElasticSheet::setPositions: non-finite position");
   impl_->x = x;
+  impl_->trackBranches(x);
 }
 
 void ElasticSheet::setVelocities(const std::vector<Vec3>& v) {
@@ -835,7 +879,7 @@ double ElasticSheet::bendingEnergy() const {
     e +=
         sim::bendingEnergy(m.x[static_cast<std::size_t>(h[0])], m.x[static_cast<std::size_t>(h[1])],
                            m.x[static_cast<std::size_t>(h[2])], m.x[static_cast<std::size_t>(h[3])],
-                           m.hingeStiffnessOf(k), m.hingeRest[k]);
+                           m.hingeStiffnessOf(k), m.branchRest(k, m.x));
   }
   return e;
 }

@@ -60,4 +60,14 @@ PhysicalMesh buildPhysicalMesh(const GeometricMesh& g, const CrumpleParams& para
 void updateSamples(PhysicalMesh& p, const GeometricMesh& g,
                    std::vector<Vec3>* velocities = nullptr);
 
+// Bending-stiffness factor of every hinge of S_P (in `hinges` order):
+// min(1, ((A1 + A2) / |e|^2) / ratio) from the hinge's two pattern triangles
+// and its pattern length (two equilateral triangles give 0.87). The discrete
+// hinge stiffness grows like |e|^2 / (A1 + A2) and its Hessian like
+// 1 / height^3, so the long thin cells rulings make would stall Newton;
+// below `ratio` (CrumpleParams::sliverHingeRatio) the hinge is softened in
+// proportion. Boundary edges get 1.
+std::vector<double> sliverHingeFactors(const mesh::SheetMesh& sp,
+                                       const std::vector<mesh::MeshEdge>& hinges, double ratio);
+
 }  // namespace crumple::paper

@@ -47,8 +47,15 @@ int flipCompressedEdges(GeometricMesh& g, const CrumpleParams& params);
 // folded interior edge is offered to the ruling machinery as a strip of
 // rulings parallel to that edge (S_P bends smoothly across S_G's internal
 // edges; see docs/CRUMPLING.md). Returns the number of regions bent.
+// With `sp` (S_P with its positions after the elastic step), the rulings
+// follow how S_P actually bends inside the region instead: parallel to the
+// principal direction of sum theta^2 e e^T over S_P's hinges there (the
+// direction S_P bends across), through its most bent hinge. A twisting or
+// rolling sheet folds S_G's few triangles along edges that are not rulings
+// (the diagonal of a strip), which would otherwise make a crease.
 int bendFoldedFlatRegions(GeometricMesh& g, const CrumpleParams& params,
-                          const BoundaryPosition& boundary, GeometricStepStats& stats);
+                          const BoundaryPosition& boundary, GeometricStepStats& stats,
+                          const mesh::SheetMesh* sp = nullptr);
 
 // paper Sec. 5.1: a flat region is a maximal connected set of pairwise
 // coplanar triangles (dihedral <= theta_0). Relabels flat faces into such

@@ -18,11 +18,16 @@ struct CrumpleParams {
   // 10 cm sheet then has 48 boundary and ~25-36 interior samples, ~118
   // triangles (Table V, Fig. 1). See docs/CRUMPLING.md "S_P size".
   double rhoInt = 3600.0;
-  double theta0 = 0.01;                       // coplanarity threshold (rad)
-  double thetaLow = 0.001;                    // junction hysteresis, theta0 / 10
-  double thetaHigh = 0.01;                    // junction hysteresis, theta0
-  double epsBlaschke = 0.005;                 // cone-fit tolerance as a fraction of L_paper
-  double epsC = 0.001;                        // compression threshold (0.1 %)
+  double theta0 = 0.01;        // coplanarity threshold (rad)
+  double thetaLow = 0.001;     // junction hysteresis, theta0 / 10
+  double thetaHigh = 0.01;     // junction hysteresis, theta0
+  double epsBlaschke = 0.005;  // cone-fit tolerance as a fraction of L_paper
+  double epsC = 0.001;         // compression threshold (0.1 %)
+  // A ruling of a curved region gets a d-cone (treatCurvedCompression, our
+  // extension) when compressed by more than this times epsC: rulings are
+  // straight in S_G but S_P bends smoothly across them, so a twisting strip
+  // shortens them slightly without any crumpling (moebius: 0.11 %).
+  double curvedCompressionFactor = 5.0;
   double sigma = 0.001;                       // singular-vertex position spread (0.1 cm)
   double thetaRest = std::numbers::pi / 8.0;  // fiber damage rest angle (thesis eq. 2.1)
   double damage = 10.0;                       // fiber damage D (thesis eq. 2.2)
@@ -33,6 +38,17 @@ struct CrumpleParams {
   // range" (paper Sec. 1), lengths are restored by the isometry step.
   double membraneScale = 0.01;
   double minVertexMassFraction = 0.05;  // sim::SimParams::minVertexMassFraction for S_P
+  // Hinges of S_P whose two triangles are slivers, (A1 + A2) / |e|^2 below
+  // this (0.87 for two equilateral triangles), are softened by that ratio:
+  // the discrete hinge stiffness grows like |e|^2 / (A1 + A2) and its
+  // Hessian like 1 / height^3, which stalls Newton on the long thin cells
+  // that rulings make (see docs/CRUMPLING.md "Sliver hinges").
+  double sliverHingeRatio = 0.1;
+  // Newton tolerance of the coarse FEM on S_P (sim::SimParams::newtonTolerance,
+  // a fraction of the mean edge length): the isometry step moves S_P's
+  // vertices by ~1e-2 of an edge every step, so resolving the elastic step to
+  // the plain model's 1e-7 buys nothing and stalls Newton on compressed cells.
+  double newtonTolerance = 1e-4;
   // Steps a region waits after it was cut before its compression is treated
   // again: cutting a compressed region leaves equally compressed pieces
   // until the elastic steps have bent S_P along the new structure (Appendix

@@ -1,0 +1,140 @@
+// HandleRig::rebindTangents: after the hybrid model rebuilds its mesh, the
+// tangent-plane pins hold the pattern's shape around the handle, rigidly
+// turned (Kabsch) to fit where the sheet is now.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "crumple/io/animation.hpp"
+#include "crumple/io/scene.hpp"
+#include "crumple/mesh/sheet_mesh.hpp"
+#include "crumple/pipeline/handle_rig.hpp"
+#include "crumple/sim/elastic_sheet.hpp"
+#include "test_util.hpp"
+
+using namespace crumple;
+using namespace crumple::testing;
+
+namespace {
+
+// One tangent-controlled handle on an interior vertex of a 10 x 10 cm
+// criss-cross sheet (2.5 cm cells), held by node "A", which moves and turns
+// between t = 0 and t = 1 s so that the node's frame at the rebind time is
+// neither the identity nor the bind-time frame.
+struct RigFixture {
+  TempDir tmp;
+  io::SceneSpec spec;
+  io::AnimationScene anim;
+  mesh::SheetMesh sheet;
+  int handleVertex = -1;
+
+  static io::AnimationScene loadAnimation(const TempDir& dir) {
+    const Quat q0(Eigen::AngleAxisd(0.9, Vec3(0.3, -0.5, 0.8).normalized()));
+    const Quat q1(Eigen::AngleAxisd(-0.4, Vec3(-0.7, 0.2, 0.4).normalized()));
+    auto f = [](double v) { return static_cast<float>(v); };
+    GltfTrack a{"A",
+                {0.0f, 1.0f},
+                {{0.01f, 0.20f, -0.03f}, {0.04f, 0.17f, 0.02f}},
+                {{f(q0.x()), f(q0.y()), f(q0.z()), f(q0.w())},
+                 {f(q1.x()), f(q1.y()), f(q1.z()), f(q1.w())}}};
+    writeFile(dir / "anim.gltf", makeGltf({a}));
+    return io::AnimationScene::load((dir / "anim.gltf").string());
+  }
+
+  RigFixture() : anim(loadAnimation(tmp)), sheet(mesh::makeRectangleSheet(0.1, 0.1, 0.025)) {
+    spec.file = (tmp / "scene.toml").string();
+    io::HandleSpec h;
+    h.name = "hold";
+    h.node = "A";
+    h.patternPoint = Vec2(0.025, 0.05);
+    h.tangentControl = true;
+    spec.handles.push_back(h);
+    handleVertex = mesh::nearestPatternVertex(sheet, *h.patternPoint);
+  }
+
+  // The pattern offset of vertex n from the handle vertex, in the plane z = 0.
+  Vec3 flat(int n) const {
+    const Vec2 d = sheet.pattern[static_cast<std::size_t>(n)] -
+                   sheet.pattern[static_cast<std::size_t>(handleVertex)];
+    return {d.x(), d.y(), 0.0};
+  }
+
+  // Every vertex at centre + shape * (its pattern offset from the handle).
+  void place(const Vec3& centre, const Mat3& shape) {
+    for (std::size_t n = 0; n < sheet.vertexCount(); ++n)
+      sheet.positions[n] = centre + shape * flat(static_cast<int>(n));
+  }
+};
+
+}  // namespace
+
+TEST(HandleRig, RebindKeepsThePatternDistancesOfAStretchedNeighbourhood) {
+  RigFixture f;
+  // Bind on a neighbourhood compressed to 0.8 (so offsets kept from the bind
+  // would be 0.8x the pattern), then rebind at t = 0.5 s on one stretched to
+  // 1.1x around the handle and tilted: offsets copied from the current
+  // positions would be 1.1x the pattern.
+  f.place(f.anim.worldPose("A", 0.0).position, 0.8 * Mat3::Identity());
+  pipeline::HandleRig rig(f.spec, &f.anim, f.sheet, 0.0);
+  ASSERT_EQ(rig.handles().size(), 1u);
+  const double t = 0.5;
+  const Vec3 node = rig.target(0, t);
+  const Mat3 tilt = Eigen::AngleAxisd(0.3, Vec3(1.0, 2.0, -0.5).normalized()).toRotationMatrix();
+  f.place(node, 1.1 * tilt);
+  rig.rebindTangents(f.sheet, t);
+
+  std::vector<sim::Pin> pins;
+  rig.pins(t, pins);
+  ASSERT_EQ(pins.size(), 5u) << "an interior handle holds four tangent-plane vertices";
+  EXPECT_EQ(pins[0].vertex, f.handleVertex);
+  EXPECT_LT((pins[0].position - node).norm(), 1e-15);
+  for (std::size_t k = 1; k < pins.size(); ++k) {
+    // Handle to tangent pin: the pattern distance, not 1.1x (nor 0.8x) of it.
+    const double pattern = f.flat(pins[k].vertex).norm();
+    const double pinned = (pins[k].position - pins[0].position).norm();
+    EXPECT_NEAR(pinned / pattern, 1.0, 1e-12) << "tangent vertex " << pins[k].vertex;
+    // Tangent pin to tangent pin: the pattern distance too.
+    for (std::size_t j = k + 1; j < pins.size(); ++j) {
+      const double patternKJ = (f.flat(pins[k].vertex) - f.flat(pins[j].vertex)).norm();
+      const double pinnedKJ = (pins[k].position - pins[j].position).norm();
+      EXPECT_NEAR(pinnedKJ / patternKJ, 1.0, 1e-12)
+          << "tangent vertices " << pins[k].vertex << ", " << pins[j].vertex;
+    }
+  }
+}
+
+TEST(HandleRig, RebindTurnsThePatternOntoTheCurrentTangentPlane) {
+  RigFixture f;
+  // Bind on the flat pattern, then turn the sheet 30 degrees about an axis
+  // through the handle: the rebound pins follow the turned plane.
+  f.place(f.anim.worldPose("A", 0.0).position, Mat3::Identity());
+  pipeline::HandleRig rig(f.spec, &f.anim, f.sheet, 0.0);
+  ASSERT_EQ(rig.handles().size(), 1u);
+  const double t = 0.5;
+  const Vec3 node = rig.target(0, t);
+  const Mat3 turn =
+      Eigen::AngleAxisd(std::numbers::pi / 6, Vec3(0.4, -1.0, 0.7).normalized()).toRotationMatrix();
+  f.place(node, turn);
+  rig.rebindTangents(f.sheet, t);
+
+  // Unstretched: every pin lands exactly on where its vertex is now.
+  std::vector<sim::Pin> pins;
+  rig.pins(t, pins);
+  ASSERT_EQ(pins.size(), 5u) << "an interior handle holds four tangent-plane vertices";
+  EXPECT_EQ(pins[0].vertex, f.handleVertex);
+  for (const auto& pin : pins)
+    EXPECT_LT((pin.position - f.sheet.positions[static_cast<std::size_t>(pin.vertex)]).norm(),
+              1e-12)
+        << "vertex " << pin.vertex;
+
+  // Turned the same way and stretched 1.1x: the pins keep the turn but not
+  // the stretch, the pattern turned 30 degrees about the handle.
+  f.place(node, 1.1 * turn);
+  rig.rebindTangents(f.sheet, t);
+  rig.pins(t, pins);
+  ASSERT_EQ(pins.size(), 5u);
+  for (const auto& pin : pins)
+    EXPECT_LT((pin.position - (node + turn * f.flat(pin.vertex))).norm(), 1e-12)
+        << "vertex " << pin.vertex;
+}
