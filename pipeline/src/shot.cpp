@@ -176,6 +176,8 @@ paper::CrumpleParams crumpleParamsOf(const io::HybridSpec& h) {
   p.thetaRest = h.thetaRest;
   p.damage = h.damage;
   p.isometryIterations = h.isometryIterations;
+  p.maxSingularPerFrame = h.maxSingularPerFrame;
+  p.remeshCooldown = h.remeshCooldown;
   // Region invariants after every geometric step: always in debug builds,
   // on request (CRUMPLE_CHECK_INVARIANTS=1) in release builds.
   if (const char* env = std::getenv("CRUMPLE_CHECK_INVARIANTS"); env != nullptr && env[0] == '1')

@@ -492,7 +492,9 @@ TEST(SceneModel, EveryKeyParsedAndConvertedToSI) {
       "sigma_cm = 0.01\n"
       "theta_rest = 0.5\n"
       "damage = 4\n"
-      "isometry_iterations = 50\n");
+      "isometry_iterations = 50\n"
+      "max_singular_per_frame = 5\n"
+      "remesh_cooldown = 0\n");
   const HybridSpec& h = s.model.hybrid;
   EXPECT_EQ(s.model.type, ModelSpec::Type::Hybrid);
   EXPECT_DOUBLE_EQ(h.rhoBound, 250.0);
@@ -506,6 +508,8 @@ TEST(SceneModel, EveryKeyParsedAndConvertedToSI) {
   EXPECT_DOUBLE_EQ(h.thetaRest, 0.5);
   EXPECT_DOUBLE_EQ(h.damage, 4.0);
   EXPECT_EQ(h.isometryIterations, 50);
+  EXPECT_EQ(h.maxSingularPerFrame, 5);
+  EXPECT_EQ(h.remeshCooldown, 0);
 }
 
 TEST(SceneModel, HysteresisFollowsTheta0) {
@@ -571,6 +575,10 @@ TEST(SceneErrors, Model) {
   expectError(head + "isometry_iterations = 200000\n", 6, "model.isometry_iterations",
               {"[1, 100000]"});
   expectError(head + "isometry_iterations = 20.5\n", 6, "model.isometry_iterations",
+              {"expected an integer"});
+  expectError(head + "max_singular_per_frame = -1\n", 6, "model.max_singular_per_frame",
+              {"[0, 1000]", "got -1"});
+  expectError(head + "remesh_cooldown = 2.5\n", 6, "model.remesh_cooldown",
               {"expected an integer"});
 }
 

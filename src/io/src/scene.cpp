@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <set>
 
 #include "crumple/core/error.hpp"
@@ -435,10 +436,10 @@ class SceneParser {
     static constexpr std::string_view kHybridKeys[] = {
         "rho_bound_per_cm",   "rho_int_per_cm2", "theta0",   "theta_low",  "theta_high",
         "eps_blaschke",       "eps_c",           "sigma_cm", "theta_rest", "damage",
-        "isometry_iterations"};
+        "isometry_iterations", "max_singular_per_frame", "remesh_cooldown"};
     r.allowOnly({"type", "rho_bound_per_cm", "rho_int_per_cm2", "theta0", "theta_low", "theta_high",
                  "eps_blaschke", "eps_c", "sigma_cm", "theta_rest", "damage",
-                 "isometry_iterations"});
+                 "isometry_iterations", "max_singular_per_frame", "remesh_cooldown"});
     ModelSpec& m = spec_.model;
     m.typeLine = r.lineOf("type");
     const std::string type = r.string("type").value_or("elastic");
@@ -516,6 +517,18 @@ class SceneParser {
       }
       h.isometryIterations = static_cast<int>(*n);
     }
+    // How fast the sheet may crumple: new singular vertices per frame, and
+    // animation steps a remeshed region waits before it is remeshed again.
+    const auto count = [&](std::string_view key, long hi) -> std::optional<int> {
+      const auto n = r.integer(key);
+      if (!n) return std::nullopt;
+      if (*n < 0 || *n > hi) {
+        r.fail(key, "must be in [0, " + std::to_string(hi) + "] (got " + std::to_string(*n) + ")");
+      }
+      return static_cast<int>(*n);
+    };
+    if (auto n = count("max_singular_per_frame", 1000)) h.maxSingularPerFrame = *n;
+    if (auto n = count("remesh_cooldown", 1000)) h.remeshCooldown = *n;
   }
 
   std::string file_;

@@ -232,7 +232,7 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
                                       HybridStepStats& stats, const char*& stage) {
   Impl& m = *this;
   CrumpleParams stepParams = m.params;
-  stepParams.maxSingularPerStep = singularBudget;
+  stepParams.maxSingularPerFrame = singularBudget;
   // (a)-(b) elastic relaxation of S_P with the handles as hard constraints.
   stage = "elastic";
   auto t0 = Clock::now();
@@ -375,12 +375,12 @@ HybridStepStats HybridSheet::advance(double t, double dt, int substeps,
   const char* stage = "elastic";
   try {
     // The frame's substeps are the paper's animation steps; singular
-    // vertices appear at most maxSingularPerStep per frame.
+    // vertices appear at most maxSingularPerFrame per frame.
     const int n = std::max(1, substeps);
     std::uint64_t draw = 0;
     for (int k = 0; k < n; ++k) {
       HybridStepStats s;
-      const int budget = m.params.maxSingularPerStep - stats.geometric.singularInserted;
+      const int budget = m.params.maxSingularPerFrame - stats.geometric.singularInserted;
       m.animationStep(t + dt * k / n, dt / n, pins, frame, std::max(0, budget), draw, s, stage);
       accumulate(stats, s);
     }

@@ -896,7 +896,7 @@ void treatCurvedCompression(GeometricMesh& g, const CrumpleParams& params, const
   for (std::size_t r = 0; r < regionCount; ++r) {
     if (g.regions[r].type != mesh::RegionType::Curved || g.regions[r].apex >= 0) continue;
     if (!settled[r]) continue;
-    if (stats.singularInserted >= params.maxSingularPerStep) break;
+    if (stats.singularInserted >= params.maxSingularPerFrame) break;
     if (g.regions[r].rulings.size() < 2) continue;
     const std::vector<Ruling> rulings = orientedRulings(g, g.regions[r].rulings);
     const auto P = [&](int v) -> const Vec2& {
@@ -1286,7 +1286,7 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
         }
         const int needed = (constrained(bwd) && existingApex[0] < 0 ? 1 : 0) +
                            (constrained(fwd) && existingApex[1] < 0 ? 1 : 0);
-        if (needed > 0 && stats.singularInserted + needed > params.maxSingularPerStep) {
+        if (needed > 0 && stats.singularInserted + needed > params.maxSingularPerFrame) {
           why << "singular-vertex budget of this step used up";
           stats.notes.push_back(why.str());
           declined[r] = 1;

@@ -54,9 +54,10 @@ struct CrumpleParams {
   // until the elastic steps have bent S_P along the new structure (Appendix
   // B: "let the physical simulation further deform this region").
   int remeshCooldown = 3;
-  // At most this many new singular vertices per step (the most compressed
-  // regions first): singular points appear "progressively" (paper Sec. 7.3).
-  int maxSingularPerStep = 2;
+  // At most this many new singular vertices per frame, over its animation
+  // steps (the most compressed regions first): singular points appear
+  // "progressively" (paper Sec. 7.3).
+  int maxSingularPerFrame = 2;
 #ifdef NDEBUG
   bool checkInvariants = false;  // validate S_G and S_P after every geometric step
 #else
