@@ -433,13 +433,22 @@ class SceneParser {
   void parseModel(const toml::table* table) {
     if (!table) return;
     const TableReader r(*table, "model", file_);
-    static constexpr std::string_view kHybridKeys[] = {
-        "rho_bound_per_cm",   "rho_int_per_cm2", "theta0",   "theta_low",  "theta_high",
-        "eps_blaschke",       "eps_c",           "sigma_cm", "theta_rest", "damage",
-        "isometry_iterations", "max_singular_per_frame", "remesh_cooldown"};
+    static constexpr std::string_view kHybridKeys[] = {"rho_bound_per_cm",
+                                                       "rho_int_per_cm2",
+                                                       "theta0",
+                                                       "theta_low",
+                                                       "theta_high",
+                                                       "eps_blaschke",
+                                                       "eps_c",
+                                                       "sigma_cm",
+                                                       "theta_rest",
+                                                       "damage",
+                                                       "isometry_iterations",
+                                                       "max_singular_per_frame",
+                                                       "remesh_cooldown"};
     r.allowOnly({"type", "rho_bound_per_cm", "rho_int_per_cm2", "theta0", "theta_low", "theta_high",
-                 "eps_blaschke", "eps_c", "sigma_cm", "theta_rest", "damage",
-                 "isometry_iterations", "max_singular_per_frame", "remesh_cooldown"});
+                 "eps_blaschke", "eps_c", "sigma_cm", "theta_rest", "damage", "isometry_iterations",
+                 "max_singular_per_frame", "remesh_cooldown"});
     ModelSpec& m = spec_.model;
     m.typeLine = r.lineOf("type");
     const std::string type = r.string("type").value_or("elastic");

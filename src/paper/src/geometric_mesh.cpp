@@ -15,31 +15,43 @@ double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x
 }  // namespace
 
 std::vector<GeometricEdge> buildEdges(const GeometricMesh& g) {
-  std::map<std::pair<int, int>, GeometricEdge> edges;
+  // Half-edges sorted by (min, max) vertex pair, then by face: one
+  // allocation, the same order as a map would give.
+  struct Half {
+    std::pair<int, int> key;
+    int face;
+  };
+  std::vector<Half> halves;
+  halves.reserve(4 * g.faces.size());
   for (std::size_t f = 0; f < g.faces.size(); ++f) {
     const GeometricFace& face = g.faces[f];
     const int n = face.size();
     for (int k = 0; k < n; ++k) {
       const int a = face.v[k];
       const int b = face.v[(k + 1) % n];
-      const std::pair<int, int> key{std::min(a, b), std::max(a, b)};
-      auto [it, inserted] = edges.try_emplace(key);
-      GeometricEdge& e = it->second;
-      if (inserted) {
-        e.v = {key.first, key.second};
-        e.faces = {static_cast<int>(f), -1};
-      } else if (e.faces[1] < 0) {
-        e.faces[1] = static_cast<int>(f);
-      } else {
-        std::ostringstream msg;
-        msg << "S_G edge (" << key.first << ", " << key.second << ") has more than two faces";
-        throw std::invalid_argument(msg.str());
-      }
+      halves.push_back({{std::min(a, b), std::max(a, b)}, static_cast<int>(f)});
     }
   }
+  std::sort(halves.begin(), halves.end(), [](const Half& x, const Half& y) {
+    return x.key != y.key ? x.key < y.key : x.face < y.face;
+  });
   std::vector<GeometricEdge> out;
-  out.reserve(edges.size());
-  for (auto& [key, e] : edges) out.push_back(e);
+  out.reserve(halves.size() / 2 + 1);
+  for (std::size_t i = 0; i < halves.size();) {
+    std::size_t j = i + 1;
+    while (j < halves.size() && halves[j].key == halves[i].key) ++j;
+    if (j - i > 2) {
+      std::ostringstream msg;
+      msg << "S_G edge (" << halves[i].key.first << ", " << halves[i].key.second
+          << ") has more than two faces";
+      throw std::invalid_argument(msg.str());
+    }
+    GeometricEdge e;
+    e.v = {halves[i].key.first, halves[i].key.second};
+    e.faces = {halves[i].face, j - i == 2 ? halves[i + 1].face : -1};
+    out.push_back(e);
+    i = j;
+  }
   return out;
 }
 

@@ -12,13 +12,8 @@ namespace crumple::paper {
 
 namespace {
 
-using EdgeMap = std::map<std::pair<int, int>, std::array<int, 2>>;
-
-EdgeMap edgeMap(const GeometricMesh& g) {
-  EdgeMap map;
-  for (const GeometricEdge& e : buildEdges(g)) map[{e.v[0], e.v[1]}] = e.faces;
-  return map;
-}
+using detail::EdgeMap;
+using detail::edgeMap;
 
 std::array<int, 2> facesOf(const EdgeMap& edges, int a, int b) {
   const auto it = edges.find({std::min(a, b), std::max(a, b)});

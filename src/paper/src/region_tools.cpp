@@ -8,9 +8,11 @@
 namespace crumple::paper::detail {
 
 EdgeMap edgeMap(const GeometricMesh& g) {
-  EdgeMap map;
-  for (const GeometricEdge& e : buildEdges(g)) map[{e.v[0], e.v[1]}] = e.faces;
-  return map;
+  const std::vector<GeometricEdge> edges = buildEdges(g);  // sorted by (v0, v1)
+  std::vector<EdgeMap::value_type> entries;
+  entries.reserve(edges.size());
+  for (const GeometricEdge& e : edges) entries.emplace_back(EdgeMap::Key{e.v[0], e.v[1]}, e.faces);
+  return EdgeMap(std::move(entries));
 }
 
 int otherFace(const EdgeMap& edges, int a, int b, int face) {

@@ -1,17 +1,50 @@
 #pragma once
 // Internal helpers shared by the remeshing steps of src/paper (not installed).
+#include <algorithm>
 #include <array>
 #include <functional>
 #include <map>
 #include <optional>
 #include <span>
+#include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "crumple/paper/geometric_mesh.hpp"
 
 namespace crumple::paper::detail {
 
-using EdgeMap = std::map<std::pair<int, int>, std::array<int, 2>>;  // (min, max) -> faces
+// The S_G edges, (min, max) vertex pair -> the two faces (-1: none), as a
+// vector sorted by key: built once per remeshing and searched many times,
+// so one allocation beats a node per edge (the remeshing steps rebuild it
+// per region; it was a third of the hybrid model's run time as a std::map).
+class EdgeMap {
+ public:
+  using Key = std::pair<int, int>;
+  using value_type = std::pair<Key, std::array<int, 2>>;
+  using const_iterator = std::vector<value_type>::const_iterator;
+
+  EdgeMap() = default;
+  explicit EdgeMap(std::vector<value_type> sorted) : entries_(std::move(sorted)) {}
+  const_iterator begin() const { return entries_.begin(); }
+  const_iterator end() const { return entries_.end(); }
+  std::size_t size() const { return entries_.size(); }
+  const_iterator find(const Key& key) const {
+    const auto it =
+        std::lower_bound(entries_.begin(), entries_.end(), key,
+                         [](const value_type& entry, const Key& k) { return entry.first < k; });
+    return it != entries_.end() && it->first == key ? it : entries_.end();
+  }
+  // The faces of edge `key`; throws std::out_of_range when there is no such edge.
+  const std::array<int, 2>& at(const Key& key) const {
+    const auto it = find(key);
+    if (it == entries_.end()) throw std::out_of_range("EdgeMap: no such S_G edge");
+    return it->second;
+  }
+
+ private:
+  std::vector<value_type> entries_;
+};
 
 EdgeMap edgeMap(const GeometricMesh& g);
 
