@@ -259,13 +259,59 @@ TEST(CrumplingSamples, MoebiusStaysIsometric) {
   }
   EXPECT_LE(worstCMean, 0.002);
   EXPECT_LE(worstNComp, 0.02);
-  // The issue also asks for no singular vertex and dihedral angles below
-  // 0.3 rad; the model still crumples the band next to the moving end's
-  // handles (docs/CRUMPLING.md, status): recorded, not asserted.
+  EXPECT_EQ(interiorSingular, 0u);  // paper Table V: none
+  // The issue also asks for dihedral angles below 0.3 rad between adjacent
+  // S_P triangles; the band still bends by up to ~1.1 rad on one S_P edge
+  // 2 cm from the fixed end (docs/CRUMPLING.md, status): recorded only.
   ::testing::Test::RecordProperty("worst_c_mean", std::to_string(worstCMean));
   ::testing::Test::RecordProperty("worst_n_comp", std::to_string(worstNComp));
   ::testing::Test::RecordProperty("worst_dihedral_rad", std::to_string(worstDihedral));
   ::testing::Test::RecordProperty("singular_vertices", static_cast<int>(interiorSingular));
   std::printf("moebius: worst c_mean %.4f, n_comp %.4f, dihedral %.3f rad, %zu singular\n",
               worstCMean, worstNComp, worstDihedral, interiorSingular);
+}
+
+// paper Fig. 22 second row: the crumple sample runs to its end with finite
+// positions, a valid pattern triangulation (no inverted triangle) and S_P
+// under 400 triangles. The issue asks for at least 20 singular vertices;
+// the model reaches 11-17 over seeds 1-6 (docs/CRUMPLING.md): recorded.
+TEST(CrumplingSamples, CrumpleRunsToTheEndWithACoarseValidMesh) {
+  TempDir dir;
+  const Shot shot = simulate("crumple", 108, std::nullopt, dir);
+  ASSERT_EQ(shot.error, "");
+  ASSERT_EQ(shot.frames.size(), 109u);
+  std::size_t maxTriangles = 0;
+  for (const auto& f : shot.frames) {
+    maxTriangles = std::max(maxTriangles, f.triangles.size());
+    for (const Vec3& x : f.positions) ASSERT_TRUE(x.allFinite()) << "frame " << f.frame;
+    for (const auto& t : f.triangles) {
+      const Vec2 a =
+          f.pattern[static_cast<std::size_t>(t[1])] - f.pattern[static_cast<std::size_t>(t[0])];
+      const Vec2 b =
+          f.pattern[static_cast<std::size_t>(t[2])] - f.pattern[static_cast<std::size_t>(t[0])];
+      ASSERT_GT(a.x() * b.y() - a.y() * b.x(), 0.0) << "frame " << f.frame;
+    }
+  }
+  EXPECT_LT(maxTriangles, 400u);
+  ::testing::Test::RecordProperty("max_triangles", static_cast<int>(maxTriangles));
+  ::testing::Test::RecordProperty("singular_vertices",
+                                  static_cast<int>(shot.frames.back().singularVertices.size()));
+}
+
+// paper Fig. 21: the cylinder-fold motion on thinner paper (smaller eps_c)
+// crumples more. 1 % < 0.5 % holds on every seed tried (11-15 against
+// 19-27); 0.2 % gives about as many as 0.5 % (19-24, docs/CRUMPLING.md):
+// recorded.
+TEST(CrumplingSamples, ThinnerPaperGetsMoreSingularVertices) {
+  TempDir dir;
+  const auto finalCount = [&](const char* variant) {
+    const Shot shot = simulate(std::string("paper-types/") + variant, 102, std::nullopt, dir);
+    EXPECT_EQ(shot.error, "") << variant;
+    return shot.frames.empty() ? std::size_t{0} : shot.frames.back().singularVertices.size();
+  };
+  const std::size_t thick = finalCount("eps-1.0.toml");
+  const std::size_t medium = finalCount("eps-0.5.toml");
+  EXPECT_LT(thick, medium);
+  ::testing::Test::RecordProperty("singular_eps_1.0", static_cast<int>(thick));
+  ::testing::Test::RecordProperty("singular_eps_0.5", static_cast<int>(medium));
 }
