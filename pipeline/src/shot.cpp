@@ -495,8 +495,9 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     emit(scene.frameStart);
     for (int frame = scene.frameStart + 1; frame <= range.last; ++frame) {
       if (hybrid) {
-        // One animation step per frame (paper Fig. 16): the elastic substeps,
-        // then the geometric step, cones, S_P rebuild and isometry.
+        // The frame's substeps are the paper's animation steps (Fig. 16):
+        // each an elastic step, the geometric step, cones, S_P rebuild and
+        // isometry.
         const double t = frameTime(scene, frame - 1);
         const auto stats = hybrid->advance(t, 1.0 / scene.fps, scene.substeps, pins, frame);
         report.newtonIterations += stats.elastic.newtonIterations;

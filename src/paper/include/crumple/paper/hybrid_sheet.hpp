@@ -19,9 +19,9 @@
 
 namespace crumple::paper {
 
-// Milliseconds spent in each stage of one step.
+// Milliseconds spent in each stage over one frame (all its animation steps).
 struct HybridStageTimes {
-  double elastic = 0.0;    // FEM on S_P (all substeps)
+  double elastic = 0.0;    // FEM on S_P
   double geometric = 0.0;  // flips, splits, compression, rulings, singular vertices, junctions
   double cones = 0.0;      // generalized-cone fitting (paper Sec. 6.2)
   double rebuild = 0.0;    // S_P from S_G, fiber damage, elastic-model setup
@@ -49,11 +49,13 @@ class HybridSheet {
   HybridSheet(HybridSheet&&) noexcept;
   HybridSheet& operator=(HybridSheet&&) noexcept;
 
-  // One animation step from t to t + dt for frame `frame`: `substeps`
-  // elastic steps of dt / substeps, then the geometric step, cone fitting,
-  // S_P rebuild and isometry. Pins refer to S_G vertex indices. Throws
-  // NumericalError naming the frame and stage on failure, leaving the sheet
-  // as it was before the call.
+  // Frame `frame`, from t to t + dt, as `substeps` animation steps of
+  // dt / substeps, each an elastic step, the geometric step, cone fitting,
+  // S_P rebuild and isometry (at most maxSingularPerFrame new singular
+  // vertices over them; the stats are summed, the isometry's are the last
+  // step's). Pins refer to S_G vertex indices. Throws NumericalError naming
+  // the frame and stage on failure, leaving the sheet as it was before the
+  // call.
   HybridStepStats advance(double t, double dt, int substeps, const sim::PinFunction& pins,
                           int frame);
 
