@@ -1067,8 +1067,7 @@ int bendFoldedFlatRegions(GeometricMesh& g, const CrumpleParams& params,
                           const BoundaryPosition& boundary, GeometricStepStats& stats,
                           const mesh::SheetMesh* sp) {
   int bent = 0;
-  const std::vector<mesh::MeshEdge> spEdges =
-      sp != nullptr ? mesh::buildEdges(*sp) : std::vector<mesh::MeshEdge>{};
+  std::optional<std::vector<mesh::MeshEdge>> spEdges;  // S_P's edges, once a region folds
   const std::size_t regionCount = g.regions.size();
   for (std::size_t r = 0; r < regionCount; ++r) {
     if (g.regions[r].type != mesh::RegionType::Flat) continue;
@@ -1097,7 +1096,9 @@ int bendFoldedFlatRegions(GeometricMesh& g, const CrumpleParams& params,
     std::vector<Pencil> candidates;
     const Vec2 foldMid = 0.5 * (a + b);
     if (sp != nullptr) {
-      if (const auto bend = bendingDirection(g, static_cast<int>(r), *sp, spEdges, params.theta0)) {
+      if (!spEdges) spEdges = mesh::buildEdges(*sp);
+      if (const auto bend =
+              bendingDirection(g, static_cast<int>(r), *sp, *spEdges, params.theta0)) {
         candidates.push_back({-1, bend->first, bend->second});
         candidates.push_back({-1, foldMid, bend->second});
       }
