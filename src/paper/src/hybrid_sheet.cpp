@@ -173,7 +173,7 @@ HybridSheet::HybridSheet(GeometricMesh sg, const sim::Material& material,
   m.simParams.membraneScale = params.membraneScale;
   m.simParams.minVertexMassFraction = params.minVertexMassFraction;
   m.simParams.newtonTolerance = params.newtonTolerance;
-  m.simParams.maxNewtonIterations = std::max(m.simParams.maxNewtonIterations, 60);
+  m.simParams.maxNewtonIterations = params.newtonIterations;
   m.params = params;
   m.seed = seed;
   for (const Vec2& a : m.sg.outline) {

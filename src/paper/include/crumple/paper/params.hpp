@@ -49,9 +49,9 @@ struct CrumpleParams {
   // S_P's vertices by ~1e-2 of an edge every step, so resolving the elastic
   // step to the plain model's 1e-7 buys nothing and stalls Newton on
   // compressed cells (with 1e-4 moebius grew 7-13 singular vertices and
-  // crumple failed in 2 of 3 seeds; with 1e-3 none and none). S_P's Newton
-  // also gets 60 iterations instead of 30 (HybridSheet).
+  // crumple failed in 2 of 3 seeds; with 1e-3 none and none).
   double newtonTolerance = 1e-3;
+  int newtonIterations = 60;  // sim::SimParams::maxNewtonIterations for S_P (plain model: 30)
   // Steps a region waits after it was cut before its compression is treated
   // again: cutting a compressed region leaves equally compressed pieces
   // until the elastic steps have bent S_P along the new structure (Appendix
