@@ -25,7 +25,8 @@ void BM_IsometryProject(benchmark::State& state) {
     for (int c = 0; c < 3; ++c) x[c] += 0.01 * maxEdge * (2.0 * rng.uniform(draw++) - 1.0);
     noisy.push_back(x);
   }
-  paper::IsometryProjector projector(sheet.pattern, sheet.triangles, {0, static_cast<int>(sheet.pattern.size()) - 1});
+  paper::IsometryProjector projector(sheet.pattern, sheet.triangles,
+                                     {0, static_cast<int>(sheet.pattern.size()) - 1});
   paper::IsometryStats stats;
   for (auto _ : state) {
     std::vector<Vec3> p = noisy;
