@@ -216,12 +216,13 @@ double rulingDihedral(const GeometricMesh& g, int region, int k) {
 // the opposite-region rule of Fig. 13.
 void updateJunctions(GeometricMesh& g, const CrumpleParams& params,
                      const BoundaryPosition& boundary, GeometricStepStats& stats) {
+  detail::EdgeMapCache edgeCache;
   for (std::size_t ri = 0; ri < g.regions.size(); ++ri) {
     if (g.regions[ri].type != mesh::RegionType::Curved) continue;
     const int region = static_cast<int>(ri);
     std::vector<Ruling> rulings = g.regions[ri].rulings;
     if (rulings.size() < 2) continue;
-    const EdgeMap edges = edgeMap(g);
+    const EdgeMap& edges = edgeCache.of(g);
     // Dihedral at every ruling (0 at an end ruling on dS).
     std::vector<double> angle(rulings.size(), 0.0);
     std::vector<int> outside(rulings.size(), -1);  // face across an end ruling

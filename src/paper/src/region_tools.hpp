@@ -48,6 +48,26 @@ class EdgeMap {
 
 EdgeMap edgeMap(const GeometricMesh& g);
 
+// edgeMap(g), rebuilt only when g's faces changed since the last call: the
+// remeshing loops look at every region in turn and most leave S_G as it was.
+// The returned map stays valid until the next call.
+class EdgeMapCache {
+ public:
+  const EdgeMap& of(const GeometricMesh& g) {
+    if (!valid_ || faces_ != g.faces) {
+      map_ = edgeMap(g);
+      faces_ = g.faces;
+      valid_ = true;
+    }
+    return map_;
+  }
+
+ private:
+  bool valid_ = false;
+  std::vector<GeometricFace> faces_;
+  EdgeMap map_;
+};
+
 // The face across edge (a, b) from `face`, or -1.
 int otherFace(const EdgeMap& edges, int a, int b, int face);
 

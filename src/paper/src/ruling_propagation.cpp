@@ -1068,10 +1068,11 @@ int bendFoldedFlatRegions(GeometricMesh& g, const CrumpleParams& params,
                           const mesh::SheetMesh* sp) {
   int bent = 0;
   std::optional<std::vector<mesh::MeshEdge>> spEdges;  // S_P's edges, once a region folds
+  detail::EdgeMapCache edgeCache;
   const std::size_t regionCount = g.regions.size();
   for (std::size_t r = 0; r < regionCount; ++r) {
     if (g.regions[r].type != mesh::RegionType::Flat) continue;
-    const EdgeMap edges = edgeMap(g);
+    const EdgeMap& edges = edgeCache.of(g);
     double best = params.theta0;
     std::pair<int, int> fold{-1, -1};
     for (const auto& [key, faces] : edges) {
@@ -1149,6 +1150,7 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
                       const BoundaryPosition& boundary, const CounterRng& rng,
                       std::uint64_t& drawIndex, GeometricStepStats& stats,
                       const FaceFilter& mayRemesh) {
+  detail::EdgeMapCache edgeCache;
   // Regions holding a face that may not be remeshed yet wait (cooldown).
   std::vector<char> declined(g.regions.size(), 0);
   for (std::size_t f = 0; f < g.faces.size() && mayRemesh; ++f) {
@@ -1218,7 +1220,7 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
       };
       try {
         // (b) the borders of the strip along +-v_perp (Appendix A, Fig. 6).
-        const EdgeMap edges = edgeMap(g);
+        const EdgeMap& edges = edgeCache.of(g);
         const auto loop = regionLoop(g, static_cast<int>(r), edges);
         if (!loop) {
           declined[r] = 1;

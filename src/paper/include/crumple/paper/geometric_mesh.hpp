@@ -32,6 +32,7 @@ struct GeometricFace {
   std::array<int, 4> v{-1, -1, -1, -1};
   int region = -1;
   int size() const { return v[3] < 0 ? 3 : 4; }
+  friend bool operator==(const GeometricFace&, const GeometricFace&) = default;
 };
 
 // A ruling of a curved region: the S_G edge (a, b), straight on the surface
