@@ -2,7 +2,6 @@
 // 2.5.1, Figs. 12-13 / 2.15-2.16).
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <numeric>
 
 #include "crumple/paper/geometric_step.hpp"

@@ -1,6 +1,7 @@
 #include "region_tools.hpp"
 
 #include <algorithm>
+#include <map>
 #include <cmath>
 
 #include "crumple/mesh/delaunay.hpp"
