@@ -1,8 +1,8 @@
 #include "region_tools.hpp"
 
 #include <algorithm>
-#include <map>
 #include <cmath>
+#include <map>
 
 #include "crumple/mesh/delaunay.hpp"
 
