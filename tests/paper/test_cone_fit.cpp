@@ -794,3 +794,24 @@ TEST(ConeFit, RefitOfASharpConeKeepsRulingEndsApart) {
   compact(g);  // may move the regions: `rulings` is not used after this
   EXPECT_EQ(validate(g), "");
 }
+
+// A ruling is a straight segment of the surface: on an exact cylinder strip
+// no ruling is shorter in space than in the pattern; bending the sheet across
+// one ruling (its top end pulled 1 mm towards its bottom end) compresses it
+// by 1 %, which worstRulingCompression reports; stretching reports nothing.
+TEST(ConeFit, WorstRulingCompressionSeesARulingCutAcrossTheBending) {
+  const double r = 0.05;
+  const auto embed = [r](const Vec2& p) -> Vec3 {
+    const double th = p.x() / r;
+    return {r * std::sin(th), p.y(), r * (1.0 - std::cos(th))};
+  };
+  StripSheet sheet = makeStrip({0.03, 0.04, 0.05, 0.06, 0.07}, embed);
+  GeometricMesh& g = sheet.g;
+  ASSERT_EQ(validate(g), "");
+  EXPECT_LT(worstRulingCompression(g, sheet.curved), 1e-12);
+  g.vertices[static_cast<std::size_t>(sheet.top[2])].position -= Vec3(0.0, 0.001, 0.0);
+  EXPECT_NEAR(worstRulingCompression(g, sheet.curved), 0.01, 1e-12);
+  g.vertices[static_cast<std::size_t>(sheet.top[2])].position += Vec3(0.0, 0.002, 0.0);
+  EXPECT_LT(worstRulingCompression(g, sheet.curved), 1e-12);  // stretched, not compressed
+  EXPECT_THROW(worstRulingCompression(g, 7), std::out_of_range);
+}

@@ -413,6 +413,45 @@ TEST(Isometry, InvalidTopologyIsRejected) {
   EXPECT_EQ(ok.edgeCount(), 3);
 }
 
+// Deviation 7: Gauss-Seidel length sweeps after Phase II take the noisy roll
+// much closer to isometry than Phase I + II alone, keep the handles exactly
+// where they were, and stop early once every edge is within tolerance.
+TEST(Isometry, LengthSweepsPolishWhatPhaseTwoLeaves) {
+  const NoisyRoll r = makeNoisyRoll(0.06, 0.012, 42);
+  const std::vector<int> fixed{r.grid.cornerA(), r.grid.cornerB()};
+  IsometryProjector paper(r.grid.sheet.pattern, r.grid.sheet.triangles, fixed);
+  std::vector<Vec3> a = r.noisy;
+  const IsometryStats sa = paper.project(a);
+  EXPECT_EQ(sa.lengthSweeps, 0);
+  IsometryProjector polished(r.grid.sheet.pattern, r.grid.sheet.triangles, fixed,
+                             {.lengthSweeps = 300, .lengthTolerance = 1e-6});
+  std::vector<Vec3> b = r.noisy;
+  const IsometryStats sb = polished.project(b);
+  std::printf("noisy roll: c_mean %.3e (Phase I + II) -> %.3e (+ %d sweeps), max %.3e\n",
+              sa.meanLengthErrorAfter, sb.meanLengthErrorAfter, sb.lengthSweeps,
+              sb.maxLengthErrorAfter);
+  ::testing::Test::RecordProperty("cmean_phase_one_two", sci(sa.meanLengthErrorAfter));
+  ::testing::Test::RecordProperty("cmean_with_sweeps", sci(sb.meanLengthErrorAfter));
+  ::testing::Test::RecordProperty("sweeps", sb.lengthSweeps);
+  EXPECT_NEAR(sb.meanLengthErrorAfter, meanLengthError(r.grid.sheet, b), 1e-15);
+  EXPECT_LT(sb.meanLengthErrorAfter, sa.meanLengthErrorAfter / 5.0);
+  EXPECT_GT(sb.lengthSweeps, 0);
+  if (sb.lengthSweeps < 300) {
+    EXPECT_LT(sb.maxLengthErrorAfter, 1e-6);  // stopped at tolerance
+  }
+  for (int v : fixed) EXPECT_EQ(b[v], r.noisy[v]) << "handle " << v << " moved";
+  EXPECT_LT(meanDistance(b, r.clean), meanDistance(r.noisy, r.clean));
+  // An exactly isometric input needs one sweep to see it and moves nothing.
+  const std::vector<Vec3> clean = r.clean;
+  std::vector<Vec3> c = clean;
+  const IsometryStats sc = polished.project(c);
+  EXPECT_EQ(sc.lengthSweeps, 1);
+  EXPECT_LT(maxDistance(c, clean), 1e-12);
+  EXPECT_THROW(
+      IsometryProjector(r.grid.sheet.pattern, r.grid.sheet.triangles, fixed, {.lengthSweeps = -1}),
+      std::invalid_argument);
+}
+
 // Test 6: two runs give bit-identical output.
 TEST(Isometry, Deterministic) {
   const NoisyRoll r = makeNoisyRoll(0.06, 0.012, 11);

@@ -55,21 +55,24 @@ Shot simulate(const std::string& sample, int last, std::optional<std::uint64_t> 
 
 }  // namespace
 
-// paper Fig. 1, first half: the wrap into a cylinder is smooth -- no singular
-// vertex, rulings parallel to the cylinder's axis (the pattern's v direction)
-// within 5 degrees, lengths kept (paper Table IV measures) on every frame.
-TEST(CrumplingSamples, CylinderFoldWrapIsSmoothWithRulingsAlongTheAxis) {
+// paper Fig. 1: the wrap into a cylinder is smooth -- no singular vertex,
+// rulings parallel to the cylinder's axis (the pattern's v direction) within
+// 5 degrees; the orthogonal bend then makes singular vertices; lengths are
+// kept (paper Table IV measures) on every frame of the shot.
+TEST(CrumplingSamples, CylinderFoldWrapIsSmoothThenTheBendMakesSingularVertices) {
   TempDir dir;
-  const Shot shot =
-      simulate("cylinder-fold", 53, std::nullopt, dir);  // the bend starts at 2.25 s (frame 54)
+  const Shot shot = simulate("cylinder-fold", 102, std::nullopt, dir);
   ASSERT_EQ(shot.error, "");
-  ASSERT_EQ(shot.frames.size(), 54u);
+  ASSERT_EQ(shot.frames.size(), 103u);
   double worstCMean = 0.0, worstNComp = 0.0, worstAngle = 0.0;
   std::size_t framesWithRulings = 0;
   for (const auto& f : shot.frames) {
     const auto m = pipeline::measureFrame(f);
+    EXPECT_LE(m.cMean, 0.005) << "frame " << f.frame;
+    EXPECT_LE(m.nComp, 0.02) << "frame " << f.frame;
     worstCMean = std::max(worstCMean, m.cMean);
     worstNComp = std::max(worstNComp, m.nComp);
+    if (f.frame > 53) continue;  // the bend starts at 2.25 s (frame 54)
     EXPECT_TRUE(f.singularVertices.empty()) << "frame " << f.frame;
     if (!f.rulings.empty()) ++framesWithRulings;
     for (const auto& r : f.rulings) {
@@ -80,12 +83,15 @@ TEST(CrumplingSamples, CylinderFoldWrapIsSmoothWithRulingsAlongTheAxis) {
   }
   EXPECT_GT(framesWithRulings, 30u);  // the sheet is curved for most of the wrap
   EXPECT_LT(worstAngle, 5.0 * std::numbers::pi / 180.0);
-  EXPECT_LE(worstCMean, 0.005);
-  EXPECT_LE(worstNComp, 0.02);
+  EXPECT_GE(shot.frames.back().singularVertices.size(), 1u);
   ::testing::Test::RecordProperty("worst_c_mean", std::to_string(worstCMean));
   ::testing::Test::RecordProperty("worst_n_comp", std::to_string(worstNComp));
   ::testing::Test::RecordProperty("worst_ruling_angle_deg",
                                   std::to_string(worstAngle * 180.0 / std::numbers::pi));
+  ::testing::Test::RecordProperty("singular_vertices",
+                                  static_cast<int>(shot.frames.back().singularVertices.size()));
+  std::printf("cylinder-fold: worst c_mean %.4f, n_comp %.4f, %zu singular vertices\n", worstCMean,
+              worstNComp, shot.frames.back().singularVertices.size());
 }
 
 // paper Sec. 7.1, Fig. 17: no singular vertex while the sides come 10 %
@@ -97,13 +103,15 @@ TEST(CrumplingSamples, FirstSingularityAppearsUnderTheOrthogonalConstraint) {
     int frame = -1;
     Vec2 position = Vec2::Zero();
   };
+  // Seed 1 runs the whole shot (to frame 96), the others to frame 52.
   const auto firstSingular = [&](std::uint64_t seed) {
-    const Shot shot = simulate("first-singularity", 52, seed, dir);
+    const Shot shot = simulate("first-singularity", seed == 1 ? 96 : 52, seed, dir);
     EXPECT_EQ(shot.error, "");
     First first;
     for (const auto& f : shot.frames) {
       const auto m = pipeline::measureFrame(f);
       EXPECT_LE(m.cMean, 0.005) << "seed " << seed << " frame " << f.frame;
+      EXPECT_LE(m.nComp, 0.02) << "seed " << seed << " frame " << f.frame;
       if (first.frame < 0 && !f.singularVertices.empty()) {
         first.frame = f.frame;
         first.position = f.pattern[static_cast<std::size_t>(f.singularVertices.front())];
@@ -231,6 +239,11 @@ TEST(CrumplingSamples, UnloadKeepsItsSingularVertices) {
     if (f.frame == 65) atRelease = f.singularVertices.size();
   }
   ASSERT_GT(atRelease, 0u);
+  for (const auto& f : shot.frames) {
+    const auto m = pipeline::measureFrame(f);
+    EXPECT_LE(m.cMean, 0.005) << "frame " << f.frame;
+    EXPECT_LE(m.nComp, 0.02) << "frame " << f.frame;
+  }
   const auto& last = shot.frames.back();
   EXPECT_GE(last.singularVertices.size(), atRelease);  // never removed
   double weakest = 10.0;

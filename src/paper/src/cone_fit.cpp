@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "crumple/core/error.hpp"
+#include "crumple/paper/compression.hpp"
 
 namespace crumple::paper {
 
@@ -1293,6 +1294,16 @@ ConeRefitResult refitCurvedRegion(GeometricMesh& g, int region, const BoundaryCu
   result.segments = std::move(runResults.back().segments);
   result.apices = std::move(runResults.back().apices);
   return result;
+}
+
+double worstRulingCompression(const GeometricMesh& g, int region) {
+  double worst = 0.0;
+  for (const Ruling& r : g.regions.at(static_cast<std::size_t>(region)).rulings) {
+    const GeometricVertex& a = g.vertices.at(static_cast<std::size_t>(r.a));
+    const GeometricVertex& b = g.vertices.at(static_cast<std::size_t>(r.b));
+    worst = std::max(worst, edgeCompression(a.pattern, b.pattern, a.position, b.position));
+  }
+  return worst;
 }
 
 }  // namespace crumple::paper

@@ -299,6 +299,22 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
                                       " undone (" + problem + ")");
       continue;
     }
+    // A ruling is a straight segment of the surface, as long in space as in
+    // the pattern. A fit whose new rulings are shorter than their pattern
+    // (cutting across S_P's bending) by more than a d-cone's threshold, and
+    // more than the rulings it replaces, is not a cone of this surface:
+    // undone (docs/CRUMPLING.md).
+    if (fit.changed) {
+      const double after = worstRulingCompression(m.sg, static_cast<int>(r));
+      if (after > m.params.curvedCompressionFactor * m.params.epsC &&
+          after > worstRulingCompression(before, static_cast<int>(r))) {
+        m.sg = before;
+        stats.geometric.notes.push_back("cone fit of curved region " + std::to_string(r) +
+                                        " undone (a new ruling compressed " +
+                                        std::to_string(after) + ")");
+        continue;
+      }
+    }
     stats.coneSegments += fit.segmentCount;
   }
   compact(m.sg);
@@ -329,7 +345,15 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
   std::vector<sim::Pin> pinned;
   pins(t + dt, pinned);
   std::vector<int> fixed;
-  for (const sim::Pin& p : pinned) fixed.push_back(p.vertex);
+  for (const sim::Pin& p : pinned) {
+    // Tangent-plane pins are S_P vertices that are not handles: they bind in
+    // the elastic step only unless isometryHoldsTangentPins (params.hpp).
+    const auto v = static_cast<std::size_t>(p.vertex);
+    if (!m.params.isometryHoldsTangentPins &&
+        (v >= m.sg.vertices.size() || !m.sg.vertices[v].handle))
+      continue;
+    fixed.push_back(p.vertex);
+  }
   std::sort(fixed.begin(), fixed.end());
   fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
   if (!m.isometry || !m.isometry->sameTopology(m.sp.mesh.triangles, fixed) ||
@@ -337,6 +361,8 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
       stats.topologyChanged) {
     IsometryOptions iso;
     iso.rounds = m.params.isometryRounds;
+    iso.lengthSweeps = m.params.isometryLengthSweeps;
+    iso.lengthTolerance = m.params.isometryLengthTolerance;
     m.isometry.emplace(m.sp.mesh.pattern, m.sp.mesh.triangles, fixed, iso);
   }
   std::vector<Vec3> positions = m.sp.mesh.positions;

@@ -46,7 +46,40 @@ struct IsometryProjector::Impl {
   void build();
   int phaseOne(const std::vector<Vec3>& u0, std::vector<Vec3>& u, int maxIterations) const;
   std::vector<Vec3> phaseTwo(const std::vector<Vec3>& input, const std::vector<Vec3>& u) const;
+  int polishLengths(std::vector<Vec3>& p) const;
 };
+
+// Gauss-Seidel projection of every edge onto its pattern length, fixed
+// vertices immobile (our extension after Phase II; deviation 7 in the
+// header). Every sweep walks the edges in their sorted order; it stops once
+// the largest relative error is below options.lengthTolerance. Returns the
+// sweeps run.
+int IsometryProjector::Impl::polishLengths(std::vector<Vec3>& p) const {
+  std::vector<double> w(static_cast<std::size_t>(n), 1.0);  // inverse masses
+  for (int v : fixed) w[static_cast<std::size_t>(v)] = 0.0;
+  const std::size_t m = edges.size();
+  const auto project = [&](std::size_t e) {
+    const int i = edges[e][0], j = edges[e][1];
+    const double wi = w[static_cast<std::size_t>(i)], wj = w[static_cast<std::size_t>(j)];
+    if (wi + wj == 0.0) return 0.0;
+    const Vec3 d = p[j] - p[i];
+    const double len = d.norm();
+    if (!(len > 1e-14 * restLength[e])) return 0.0;  // a collapsed edge has no direction
+    const double err = (len - restLength[e]) / restLength[e];
+    const Vec3 corr = ((len - restLength[e]) / (len * (wi + wj))) * d;
+    p[i] += wi * corr;
+    p[j] -= wj * corr;
+    return std::abs(err);
+  };
+  int sweeps = 0;
+  while (sweeps < options.lengthSweeps) {
+    double worst = 0.0;
+    for (std::size_t e = 0; e < m; ++e) worst = std::max(worst, project(e));
+    ++sweeps;
+    if (worst < options.lengthTolerance) break;
+  }
+  return sweeps;
+}
 
 // Edge list, triangle-edge incidence with orientation signs (eq. (3)), and
 // the Phase II matrix of eq. (7), factored once per topology.
@@ -65,6 +98,9 @@ void IsometryProjector::Impl::build() {
   }
   if (options.rounds < 1) throw std::invalid_argument("isometry: rounds must be >= 1");
   if (!(options.tolerance > 0.0)) throw std::invalid_argument("isometry: tolerance must be > 0");
+  if (options.lengthSweeps < 0) throw std::invalid_argument("isometry: negative lengthSweeps");
+  if (!(options.lengthTolerance >= 0.0))
+    throw std::invalid_argument("isometry: lengthTolerance must be >= 0");
   std::sort(fixed.begin(), fixed.end());
   fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
   for (int v : fixed) {
@@ -391,6 +427,10 @@ IsometryStats IsometryProjector::project(std::vector<Vec3>& positions, int maxIt
       u[e] = std::isfinite(len) && len > 0.5 && len < 2.0 ? Vec3(u[e] / len) : u0[e];
     }
     current = im.phaseTwo(current, u);
+  }
+  stats.lengthSweeps = im.polishLengths(current);
+  for (const Vec3& x : current) {
+    if (!finite(x)) throw NumericalError(kStage, "non-finite position after the length sweeps");
   }
 
   lengthErrors(current, stats.meanLengthErrorAfter, stats.maxLengthErrorAfter);

@@ -997,6 +997,8 @@ void treatCurvedCompression(GeometricMesh& g, const CrumpleParams& params, const
     }
     ++stats.singularInserted;
     stats.cuts.push_back(s);
+    stats.notes.push_back("curved region " + std::to_string(r) +
+                          ": d-cone on a ruling compressed " + std::to_string(cmax));
   }
   compact(g);
 }
@@ -1376,6 +1378,11 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
           continue;
         }
         stats.cuts.push_back(centroid);
+        if (stats.singularInserted > static_cast<int>(singularBefore)) {
+          why << "strip with " << (stats.singularInserted - static_cast<int>(singularBefore))
+              << " new singular vertices";
+          stats.notes.push_back(why.str());
+        }
         for (int sv : singular) {
           if (sv >= 0 && static_cast<std::size_t>(sv) < g.vertices.size()) {
             stats.cuts.push_back(g.vertices[static_cast<std::size_t>(sv)].pattern);

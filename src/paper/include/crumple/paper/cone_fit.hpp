@@ -233,4 +233,11 @@ struct ConeRefitResult {
 ConeRefitResult refitCurvedRegion(GeometricMesh& g, int region, const BoundaryCurve& curve,
                                   const CrumpleParams& params, double paperLength);
 
+// The largest compression (1 - |x_a x_b| / |p_a p_b|, 0 when stretched) of
+// the rulings of curved region `region`: a ruling is a straight segment of
+// the surface, so a new one shorter in space than in the pattern cuts across
+// the sheet's bending. HybridSheet undoes a refit whose rulings come out
+// compressed beyond the d-cone threshold (docs/CRUMPLING.md).
+double worstRulingCompression(const GeometricMesh& g, int region);
+
 }  // namespace crumple::paper

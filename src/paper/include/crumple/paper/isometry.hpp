@@ -84,6 +84,7 @@ namespace crumple::paper {
 
 struct IsometryStats {
   int phaseOneIterations = 0;
+  int lengthSweeps = 0;                // Gauss-Seidel sweeps run after Phase II (deviation 7)
   double meanLengthErrorBefore = 0.0;  // c_mean: mean over edges of |l - lbar|/lbar (fraction)
   double meanLengthErrorAfter = 0.0;
   double maxLengthErrorAfter = 0.0;
@@ -100,6 +101,11 @@ struct IsometryOptions {
   PhaseOneObjective objective = PhaseOneObjective::Recentred;
   int rounds = 1;            // Phase I + Phase II passes per project() call (>= 1)
   double tolerance = 1e-13;  // Phase I stops when both RMS constraint violations are below
+  // Deviation 7: Gauss-Seidel sweeps over the edges after the last Phase II,
+  // stopping early once every edge is within lengthTolerance of its pattern
+  // length (relative). 0 keeps the paper's projection alone.
+  int lengthSweeps = 0;
+  double lengthTolerance = 1e-6;
 };
 
 class IsometryProjector {

@@ -33,6 +33,14 @@ struct CrumpleParams {
   double damage = 10.0;                       // fiber damage D (thesis eq. 2.2)
   int isometryIterations = 200;               // Phase I iteration cap (paper Sec. 6.3)
   int isometryRounds = 1;  // Phase I + II passes per step (IsometryOptions::rounds)
+  // Gauss-Seidel edge-length sweeps after Phase II and their early-exit
+  // tolerance (IsometryOptions::lengthSweeps, isometry.hpp deviation 7).
+  int isometryLengthSweeps = 300;
+  double isometryLengthTolerance = 1e-6;
+  // Whether the isometry also holds the handles' tangent-plane pins; by
+  // default only the handle vertices (paper Sec. 6.3 "handles fixed") and
+  // the tangent plane is imposed in the elastic step (docs/CRUMPLING.md).
+  bool isometryHoldsTangentPins = false;
   // Membrane stiffness of the coarse FEM on S_P as a fraction of the paper's
   // (sim::SimParams::membraneScale): "stiffness only needs to be of medium
   // range" (paper Sec. 1), lengths are restored by the isometry step.
