@@ -502,6 +502,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
         const auto stats = hybrid->advance(t, 1.0 / scene.fps, scene.substeps, pins, frame);
         report.newtonIterations += stats.elastic.newtonIterations;
         report.halvings += stats.elastic.halvings;
+        report.elasticRetries += stats.elasticRetries;
         report.substeps += scene.substeps;
         const std::pair<const char*, double> stages[] = {{"elastic", stats.ms.elastic},
                                                          {"geometric", stats.ms.geometric},
@@ -673,6 +674,7 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
     j.key("singular_vertices").value(r.singularVertices);
     j.key("interior_singular_vertices").value(r.interiorSingularVertices);
     j.key("max_triangles").value(static_cast<long long>(r.maxTriangles));
+    j.key("elastic_retries").value(static_cast<long long>(r.elasticRetries));
     j.endObject();
   }
   j.key("warnings").beginArray();

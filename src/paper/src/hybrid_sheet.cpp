@@ -38,6 +38,7 @@ void accumulate(HybridStepStats& total, const HybridStepStats& s) {
   total.elastic.halvings += s.elastic.halvings;
   total.elastic.solves += s.elastic.solves;
   total.elastic.finalStepNorm = s.elastic.finalStepNorm;
+  total.elasticRetries += s.elasticRetries;
   GeometricStepStats& g = total.geometric;
   const GeometricStepStats& h = s.geometric;
   g.edgeFlips += h.edgeFlips;
@@ -237,7 +238,20 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
   // (a)-(b) elastic relaxation of S_P with the handles as hard constraints.
   stage = "elastic";
   auto t0 = Clock::now();
-  stats.elastic = m.elastic->advance(t, dt, pins);
+  try {
+    stats.elastic = m.elastic->advance(t, dt, pins);
+  } catch (const NumericalError&) {
+    // The isometry leaves the tangent-plane pins where the lengths put them
+    // (isometryHoldsTangentPins); when the elastic step cannot pull them back
+    // from there, it is retried once with every pin on its target.
+    std::vector<sim::Pin> now;
+    pins(t, now);
+    std::vector<Vec3> x = m.elastic->positions();
+    for (const sim::Pin& p : now) x[static_cast<std::size_t>(p.vertex)] = p.position;
+    m.elastic->setPositions(x);
+    stats.elastic = m.elastic->advance(t, dt, pins);
+    ++stats.elasticRetries;
+  }
   stats.ms.elastic = msSince(t0);
   m.noteHinge(0);
   const std::vector<Vec3>& x = m.elastic->positions();

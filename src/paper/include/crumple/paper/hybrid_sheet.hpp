@@ -35,6 +35,7 @@ struct HybridStepStats {
   HybridStageTimes ms;
   int coneSegments = 0;
   bool topologyChanged = false;  // S_P was rebuilt with a new connectivity
+  int elasticRetries = 0;        // elastic steps retried with the pins snapped onto their targets
 };
 
 class HybridSheet {
