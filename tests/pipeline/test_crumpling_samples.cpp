@@ -224,10 +224,12 @@ double maxDihedralAround(const cache::FrameRecord& f, int v) {
 
 // paper Fig. 18 bottom: after the back handles are released and the sheet
 // settles, the singular vertices remain (plasticity) and each still marks
-// the sheet with a dihedral angle around it. The issue asks for 0.1 rad; the
-// model reaches 0.09 rad today (docs/CRUMPLING.md, status), so this asserts
-// the fold survives the release (> 0.05 rad; an undamaged sheet flattens to
-// ~0) and records the figure.
+// the sheet with a dihedral angle around it; lengths stay within the paper's
+// Table IV bounds on every frame. The issue asks for 0.1 rad; the model
+// reaches 0.069 rad (thesis eq. 2.1 rests each of the ~6 edges around a
+// singular vertex at theta_rest / 6 = 0.065 rad; docs/CRUMPLING.md), so this
+// asserts the fold survives the release (> 0.05 rad; an undamaged sheet
+// flattens to ~0) and records the figure.
 TEST(CrumplingSamples, UnloadKeepsItsSingularVertices) {
   TempDir dir;
   const Shot shot = simulate("unload", 102, std::nullopt, dir);
@@ -274,8 +276,8 @@ TEST(CrumplingSamples, MoebiusStaysIsometric) {
   EXPECT_LE(worstNComp, 0.02);
   EXPECT_EQ(interiorSingular, 0u);  // paper Table V: none
   // The issue also asks for dihedral angles below 0.3 rad between adjacent
-  // S_P triangles; the band still bends by up to ~1.1 rad on one S_P edge
-  // 2 cm from the fixed end (docs/CRUMPLING.md, status): recorded only.
+  // S_P triangles; the band still bends by up to ~1.4 rad on one S_P edge
+  // near the held end (docs/CRUMPLING.md, status): recorded only.
   ::testing::Test::RecordProperty("worst_c_mean", std::to_string(worstCMean));
   ::testing::Test::RecordProperty("worst_n_comp", std::to_string(worstNComp));
   ::testing::Test::RecordProperty("worst_dihedral_rad", std::to_string(worstDihedral));
@@ -287,7 +289,7 @@ TEST(CrumplingSamples, MoebiusStaysIsometric) {
 // paper Fig. 22 second row: the crumple sample runs to its end with finite
 // positions, a valid pattern triangulation (no inverted triangle) and S_P
 // under 400 triangles. The issue asks for at least 20 singular vertices;
-// the model reaches 11-17 over seeds 1-6 (docs/CRUMPLING.md): recorded.
+// the model reaches 11-16 over seeds 1-6 (docs/CRUMPLING.md): recorded.
 TEST(CrumplingSamples, CrumpleRunsToTheEndWithACoarseValidMesh) {
   TempDir dir;
   const Shot shot = simulate("crumple", 108, std::nullopt, dir);
@@ -312,9 +314,9 @@ TEST(CrumplingSamples, CrumpleRunsToTheEndWithACoarseValidMesh) {
 }
 
 // paper Fig. 21: the cylinder-fold motion on thinner paper (smaller eps_c)
-// crumples more. 1 % < 0.5 % holds on every seed tried (11-15 against
-// 19-27); 0.2 % gives about as many as 0.5 % (19-24, docs/CRUMPLING.md):
-// recorded.
+// crumples more. 1 % < 0.5 % holds on every seed tried (14-18 against
+// 19-26); 0.2 % gives more than 0.5 % on 2 seeds of 6 only (19-26,
+// docs/CRUMPLING.md): recorded.
 TEST(CrumplingSamples, ThinnerPaperGetsMoreSingularVertices) {
   TempDir dir;
   const auto finalCount = [&](const char* variant) {
