@@ -431,6 +431,29 @@ TEST(ElasticSheet, HingeAngleStaysContinuousWhenFoldedPastPi) {
   EXPECT_LT(sheet.maxMembraneStrain(), 1e-12);
 }
 
+TEST(ElasticSheet, HingeAngleIsRebasedBeyondOneAndAHalfTurnsOfPi) {
+  // Wound on past 1.5 pi (a caller moving vertices step by step, as the
+  // hybrid model's isometry does), the tracked angle is re-based by -2 pi
+  // instead of growing by whole turns: after 2.5 turns it reads within
+  // (-1.5 pi, 1.5 pi] and equals the rotation modulo 2 pi, with the energy
+  // k theta^2 of that angle. Without the re-basing it would read 5 pi.
+  const mesh::SheetMesh m = twoTriangleHinge();
+  ElasticSheet sheet(m, officePaper(), SimParams{});
+  const double k = twoTriangleHingeStiffness(m);
+  const int steps = static_cast<int>(std::round(5.0 * std::numbers::pi / kFoldStep));
+  double largest = 0.0;
+  for (int i = 1; i <= steps; ++i) {
+    sheet.setPositions(foldedWing(m, i * kFoldStep));
+    largest = std::max(largest, std::abs(sheet.hingeAngle(0)));
+  }
+  EXPECT_LE(largest, 1.5 * std::numbers::pi + kFoldStep);
+  EXPECT_GT(largest, 1.5 * std::numbers::pi - kFoldStep);  // it did follow past pi
+  const double phi = steps * kFoldStep;
+  const double expected = std::remainder(phi, 2.0 * std::numbers::pi);
+  EXPECT_NEAR(sheet.hingeAngle(0), expected, 1e-9);
+  EXPECT_NEAR(sheet.bendingEnergy(), k * expected * expected, 1e-9 * k * expected * expected);
+}
+
 TEST(ElasticSheet, HingeAngleUnwindsContinuouslyBackToFlat) {
   // Fold past pi, then rotate back down to flat and on to a small negative
   // fold: the angle retraces the rotation through pi and ends at 0 and then

@@ -175,6 +175,12 @@ struct ElasticSheet::Impl {
   // branch and the energy's gradient flip sign; angles are measured on the
   // branch nearest to this one instead.
   std::vector<double> hingeBranch;
+  // The branch is followed up to 1.5 pi (a flap folded half a turn through
+  // its neighbour) and re-based beyond: a vertex moved by the caller (the
+  // hybrid model's isometry step) could otherwise wind a hinge by whole turns,
+  // whose bending force then tries to unwind them (crumple: hinges at 15-100
+  // rad, 4 m/s, twice the Newton iterations; docs/CRUMPLING.md).
+  static constexpr double kMaxTrackedHinge = 1.5 * std::numbers::pi;
   std::vector<double> mass;  // lumped, kg
   std::vector<char> active;  // vertex belongs to a triangle
   double typicalEdge = 0.0;  // mean pattern edge length (m)
@@ -237,7 +243,11 @@ struct ElasticSheet::Impl {
   // Moves every hinge's branch to its angle at xs (after an accepted step
   // or a teleport by the caller).
   void trackBranches(const std::vector<Vec3>& xs) {
-    for (std::size_t k = 0; k < hingeVertices.size(); ++k) hingeBranch[k] = continuousAngle(k, xs);
+    for (std::size_t k = 0; k < hingeVertices.size(); ++k) {
+      hingeBranch[k] = continuousAngle(k, xs);
+      if (std::abs(hingeBranch[k]) > kMaxTrackedHinge)
+        hingeBranch[k] -= std::copysign(2.0 * std::numbers::pi, hingeBranch[k]);
+    }
   }
 };
 
