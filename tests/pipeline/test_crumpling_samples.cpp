@@ -194,8 +194,6 @@ TEST(CrumplingSamples, DebugStructureViewAndDeterministicCache) {
 
 namespace {
 
-// Largest dihedral angle (rad) between adjacent S_P triangles around vertex
-// v (anywhere for v < 0).
 // The dihedral angles of the S_P edges at vertex v (every interior edge
 // when v < 0), unsigned.
 std::vector<double> dihedralsAround(const cache::FrameRecord& f, int v) {
@@ -224,6 +222,8 @@ std::vector<double> dihedralsAround(const cache::FrameRecord& f, int v) {
   return out;
 }
 
+// Largest dihedral angle (rad) between adjacent S_P triangles around vertex
+// v (anywhere for v < 0).
 double maxDihedralAround(const cache::FrameRecord& f, int v) {
   const std::vector<double> d = dihedralsAround(f, v);
   return d.empty() ? 0.0 : *std::max_element(d.begin(), d.end());
