@@ -55,26 +55,38 @@ struct IsometryProjector::Impl {
 // the largest relative error is below options.lengthTolerance. Returns the
 // sweeps run.
 int IsometryProjector::Impl::polishLengths(std::vector<Vec3>& p) const {
-  std::vector<double> w(static_cast<std::size_t>(n), 1.0);  // inverse masses
-  for (int v : fixed) w[static_cast<std::size_t>(v)] = 0.0;
-  const std::size_t m = edges.size();
-  const auto project = [&](std::size_t e) {
-    const int i = edges[e][0], j = edges[e][1];
-    const double wi = w[static_cast<std::size_t>(i)], wj = w[static_cast<std::size_t>(j)];
-    if (wi + wj == 0.0) return 0.0;
-    const Vec3 d = p[j] - p[i];
-    const double len = d.norm();
-    if (!(len > 1e-14 * restLength[e])) return 0.0;  // a collapsed edge has no direction
-    const double err = (len - restLength[e]) / restLength[e];
-    const Vec3 corr = ((len - restLength[e]) / (len * (wi + wj))) * d;
-    p[i] += wi * corr;
-    p[j] -= wj * corr;
-    return std::abs(err);
+  // The edges with a free end, in sorted order, with what the projection
+  // needs inline (an edge between two fixed vertices never moves).
+  struct Rod {
+    int i, j;
+    bool freeI, freeJ;
+    double rest, weightSum;  // pattern length; inverse masses summed (1 or 2)
   };
+  std::vector<char> isFixed(static_cast<std::size_t>(n), 0);
+  for (int v : fixed) isFixed[static_cast<std::size_t>(v)] = 1;
+  std::vector<Rod> rods;
+  rods.reserve(edges.size());
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    const int i = edges[e][0], j = edges[e][1];
+    const bool fi = isFixed[static_cast<std::size_t>(i)] == 0;
+    const bool fj = isFixed[static_cast<std::size_t>(j)] == 0;
+    if (fi || fj)
+      rods.push_back({i, j, fi, fj, restLength[e], (fi ? 1.0 : 0.0) + (fj ? 1.0 : 0.0)});
+  }
   int sweeps = 0;
   while (sweeps < options.lengthSweeps) {
     double worst = 0.0;
-    for (std::size_t e = 0; e < m; ++e) worst = std::max(worst, project(e));
+    for (const Rod& r : rods) {
+      Vec3& pi = p[static_cast<std::size_t>(r.i)];
+      Vec3& pj = p[static_cast<std::size_t>(r.j)];
+      const Vec3 d = pj - pi;
+      const double len = d.norm();
+      if (!(len > 1e-14 * r.rest)) continue;  // a collapsed edge has no direction
+      const Vec3 corr = ((len - r.rest) / (len * r.weightSum)) * d;
+      if (r.freeI) pi += corr;
+      if (r.freeJ) pj -= corr;
+      worst = std::max(worst, std::abs((len - r.rest) / r.rest));
+    }
     ++sweeps;
     if (worst < options.lengthTolerance) break;
   }
@@ -260,8 +272,12 @@ int IsometryProjector::Impl::phaseOne(const std::vector<Vec3>& u0, std::vector<V
       g11 += g1[e].squaredNorm();
       g12 += g1[e].dot(g2[e]);
       g22 += g2[e].squaredNorm();
-      a1 += g1[e].dot(gradE[e]);
-      a2 += g2[e].dot(gradE[e]);
+    }
+    if (anchored) {  // grad E = 0 otherwise
+      for (std::size_t e = 0; e < m; ++e) {
+        a1 += g1[e].dot(gradE[e]);
+        a2 += g2[e].dot(gradE[e]);
+      }
     }
     const double rhs1 = c1 - a1, rhs2 = c2 - a2;
     // Guarded 2x2 solve. A constraint already met (its gradient is then
@@ -294,11 +310,13 @@ int IsometryProjector::Impl::phaseOne(const std::vector<Vec3>& u0, std::vector<V
       l2 = rhs2 / g22;
     }
     if (!std::isfinite(l1) || !std::isfinite(l2)) break;  // keep the last finite iterate
-    double maxStep = 0.0;
+    double maxStep2 = 0.0;  // the largest |step_e|^2 (one square root below)
     for (std::size_t e = 0; e < m; ++e) {
-      step[e] = -gradE[e] - l1 * g1[e] - l2 * g2[e];
-      maxStep = std::max(maxStep, step[e].norm());
+      step[e] =
+          anchored ? Vec3(-gradE[e] - l1 * g1[e] - l2 * g2[e]) : Vec3(-(l1 * g1[e]) - l2 * g2[e]);
+      maxStep2 = std::max(maxStep2, step[e].squaredNorm());
     }
+    const double maxStep = std::sqrt(maxStep2);
     if (!std::isfinite(maxStep)) break;
     // Safety cap (never reached in the tests): no direction moves by more than
     // kMaxStep per iteration, so a near-null gradient cannot fling u away.

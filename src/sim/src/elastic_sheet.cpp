@@ -232,13 +232,11 @@ struct ElasticSheet::Impl {
     const double raw = rawAngle(k, xs);
     return hingeBranch[k] + std::remainder(raw - hingeBranch[k], 2.0 * std::numbers::pi);
   }
-  // The rest angle that, used with the raw angle at xs, gives the energy of
-  // the continuous angle: k (theta_cont - rest)^2 = k (theta_raw - rest')^2.
-  double branchRest(std::size_t k, const std::vector<Vec3>& xs) const {
-    const double raw = rawAngle(k, xs);
-    const double cont =
-        hingeBranch[k] + std::remainder(raw - hingeBranch[k], 2.0 * std::numbers::pi);
-    return hingeRest[k] - (cont - raw);
+  // Deviation of hinge k from its rest angle, measured on the continuous
+  // branch, given its raw (wrapped) angle.
+  double deviation(std::size_t k, double raw) const {
+    return hingeBranch[k] + std::remainder(raw - hingeBranch[k], 2.0 * std::numbers::pi) -
+           hingeRest[k];
   }
   // Moves every hinge's branch to its angle at xs (after an accepted step
   // or a teleport by the caller).
@@ -475,13 +473,18 @@ void ElasticSheet::Impl::evaluate(const std::vector<Vec3>& xs, bool derivatives,
             const Vec3& p1 = xs[static_cast<std::size_t>(h[1])];
             const Vec3& p2 = xs[static_cast<std::size_t>(h[2])];
             const Vec3& p3 = xs[static_cast<std::size_t>(h[3])];
-            const double rest = branchRest(k, xs);
             if (!derivatives) {
-              hingeEnergy[k] = sim::bendingEnergy(p0, p1, p2, p3, stiffness, rest);
+              const double d = deviation(k, dihedralAngle(p0, p1, p2, p3));
+              hingeEnergy[k] = stiffness * d * d;
               continue;
             }
-            hingeEnergy[k] =
-                sim::bendingEnergy(p0, p1, p2, p3, stiffness, rest, &hingeGrad[k], &hingeHess[k]);
+            // E = k d^2: gradient 2k d g, Hessian 2k (g g^T + d H_theta).
+            Vec12 g;
+            const double d = deviation(k, dihedralAngle(p0, p1, p2, p3, &g, &hingeHess[k]));
+            hingeEnergy[k] = stiffness * d * d;
+            hingeGrad[k] = (2.0 * stiffness * d) * g;
+            hingeHess[k] *= 2.0 * stiffness * d;
+            hingeHess[k].noalias() += (2.0 * stiffness) * g * g.transpose();
             if (project) projectToPsd(hingeHess[k]);
           }
         }
@@ -521,13 +524,15 @@ void ElasticSheet::Impl::evaluateEnergies(const std::vector<Vec3>& xs) {
             const std::size_t k = i - nt;
             const double stiffness = hingeStiffnessOf(k);
             const auto& h = hingeVertices[k];
-            hingeTrial[k] = stiffness == 0.0
-                                ? 0.0
-                                : sim::bendingEnergy(xs[static_cast<std::size_t>(h[0])],
-                                                     xs[static_cast<std::size_t>(h[1])],
-                                                     xs[static_cast<std::size_t>(h[2])],
-                                                     xs[static_cast<std::size_t>(h[3])], stiffness,
-                                                     branchRest(k, xs));
+            if (stiffness == 0.0) {
+              hingeTrial[k] = 0.0;
+              continue;
+            }
+            const double d = deviation(k, dihedralAngle(xs[static_cast<std::size_t>(h[0])],
+                                                        xs[static_cast<std::size_t>(h[1])],
+                                                        xs[static_cast<std::size_t>(h[2])],
+                                                        xs[static_cast<std::size_t>(h[3])]));
+            hingeTrial[k] = stiffness * d * d;
           }
         }
       },
@@ -885,11 +890,8 @@ double ElasticSheet::bendingEnergy() const {
   const Impl& m = *impl_;
   double e = 0.0;
   for (std::size_t k = 0; k < m.hingeVertices.size(); ++k) {
-    const auto& h = m.hingeVertices[k];
-    e +=
-        sim::bendingEnergy(m.x[static_cast<std::size_t>(h[0])], m.x[static_cast<std::size_t>(h[1])],
-                           m.x[static_cast<std::size_t>(h[2])], m.x[static_cast<std::size_t>(h[3])],
-                           m.hingeStiffnessOf(k), m.branchRest(k, m.x));
+    const double d = m.deviation(k, m.rawAngle(k, m.x));
+    e += m.hingeStiffnessOf(k) * d * d;
   }
   return e;
 }
