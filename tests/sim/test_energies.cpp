@@ -279,6 +279,39 @@ TEST(ProjectToPsd, ClampsNegativeEigenvalues) {
   EXPECT_FALSE(projectToPsd(psd));
 }
 
+// The reduced projection of a translation-invariant Hessian equals the full
+// one: the true membrane and bending Hessians of a compressed triangle and of
+// a hinge bent against its rest angle (both indefinite).
+TEST(ProjectToPsd, TranslationInvariantReductionMatchesTheFullProjection) {
+  const MembraneModuli moduli{1e6, 5e5, 1e-4};
+  const TriangleRest rest = triangleRest(Vec2(0, 0), Vec2(0.01, 0), Vec2(0.003, 0.008));
+  Mat9 tri;
+  membraneEnergy(Vec3(0, 0, 0), Vec3(0.0093, 0.001, 0.0005), Vec3(0.002, 0.0071, -0.001), rest,
+                 moduli, nullptr, &tri);
+  Mat12 hinge;
+  bendingEnergy(Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.004, 0.008, 0.002),
+                Vec3(0.005, -0.007, 0.003), 2e-4, -0.9, nullptr, &hinge);
+  Mat9 triFull = tri, triReduced = tri;
+  Mat12 hingeFull = hinge, hingeReduced = hinge;
+  ASSERT_TRUE(projectToPsd(triFull));  // both are indefinite
+  ASSERT_TRUE(projectToPsd(hingeFull));
+  EXPECT_TRUE(projectTranslationInvariantToPsd(triReduced));
+  EXPECT_TRUE(projectTranslationInvariantToPsd(hingeReduced));
+  EXPECT_LT((triReduced - triFull).norm(), 1e-12 * triFull.norm());
+  EXPECT_LT((hingeReduced - hingeFull).norm(), 1e-12 * hingeFull.norm());
+  // Translations stay in the kernel.
+  Vec12 shift;
+  for (int a = 0; a < 4; ++a) shift.segment<3>(3 * a) = Vec3(0.3, -0.2, 0.9);
+  EXPECT_LT((hingeReduced * shift).norm(), 1e-12 * hingeReduced.norm());
+  // A PSD Hessian (a stretched triangle) is left alone.
+  Mat9 stretched;
+  membraneEnergy(Vec3(0, 0, 0), Vec3(0.0102, 0, 0), Vec3(0.003, 0.0081, 0), rest, moduli, nullptr,
+                 &stretched);
+  Mat9 copy = stretched;
+  EXPECT_FALSE(projectTranslationInvariantToPsd(copy));
+  EXPECT_EQ(copy, stretched);
+}
+
 // Calibration of k_b = D/6 (energies.hpp): a sheet wrapped on a cylinder of
 // radius R has the continuum energy D/2 kappa^2 * area.
 namespace {

@@ -24,7 +24,9 @@
 // that factorisation fails because the exact system is indefinite (compressed
 // membrane, hinges bent against their rest angle), every 9x9 / 12x12 element
 // block is projected to PSD (negative eigenvalues clamped, Eigen's
-// SelfAdjointEigenSolver) and the now SPD system is factorised instead. Exact
+// SelfAdjointEigenSolver on the 6x6 / 9x9 complement of the translations,
+// which the element energies ignore) and the now SPD system is factorised
+// instead. Exact
 // first keeps Newton's quadratic convergence near the solution (projected
 // Hessians alone converge linearly: ~10-12 iterations per step instead of
 // 4-6 on the hanging sheet, sometimes more than 30); the projection keeps
@@ -456,7 +458,7 @@ void ElasticSheet::Impl::evaluate(const std::vector<Vec3>& xs, bool derivatives,
             }
             triEnergy[i] =
                 sim::membraneEnergy(a, b, c, triangleRests[i], moduli, &triGrad[i], &triHess[i]);
-            if (project) projectToPsd(triHess[i]);
+            if (project) projectTranslationInvariantToPsd(triHess[i]);
           } else {
             const std::size_t k = i - nt;
             const double stiffness = hingeStiffnessOf(k);
@@ -485,7 +487,7 @@ void ElasticSheet::Impl::evaluate(const std::vector<Vec3>& xs, bool derivatives,
             hingeGrad[k] = (2.0 * stiffness * d) * g;
             hingeHess[k] *= 2.0 * stiffness * d;
             hingeHess[k].noalias() += (2.0 * stiffness) * g * g.transpose();
-            if (project) projectToPsd(hingeHess[k]);
+            if (project) projectTranslationInvariantToPsd(hingeHess[k]);
           }
         }
       },
@@ -500,9 +502,9 @@ void ElasticSheet::Impl::projectHessians() {
       [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i) {
           if (i < nt)
-            projectToPsd(triHess[i]);
+            projectTranslationInvariantToPsd(triHess[i]);
           else if (hingeStiffnessOf(i - nt) != 0.0)
-            projectToPsd(hingeHess[i - nt]);
+            projectTranslationInvariantToPsd(hingeHess[i - nt]);
         }
       },
       kMinChunk);

@@ -29,6 +29,47 @@ bool projectToPsdImpl(Eigen::Matrix<double, N, N>& m) {
   return true;
 }
 
+// An orthonormal basis of the vectors of R^V (V vertices, one coordinate)
+// orthogonal to (1, ..., 1): Helmert's contrasts, column k = (1, ..., 1, -k,
+// 0, ...) / sqrt(k (k + 1)) with k ones.
+template <int V>
+Eigen::Matrix<double, V, V - 1> helmertBasis() {
+  Eigen::Matrix<double, V, V - 1> q = Eigen::Matrix<double, V, V - 1>::Zero();
+  for (int k = 1; k < V; ++k) {
+    const double s = 1.0 / std::sqrt(static_cast<double>(k * (k + 1)));
+    for (int i = 0; i < k; ++i) q(i, k - 1) = s;
+    q(k, k - 1) = -k * s;
+  }
+  return q;
+}
+
+// H = Q (Q^T H Q) Q^T for H annihilating translations, Q = helmert (x) I3.
+template <int V>
+bool projectTranslationInvariantImpl(Eigen::Matrix<double, 3 * V, 3 * V>& m) {
+  constexpr int N = 3 * V, R = 3 * (V - 1);
+  static const Eigen::Matrix<double, N, R> q = [] {
+    const Eigen::Matrix<double, V, V - 1> h = helmertBasis<V>();
+    Eigen::Matrix<double, N, R> full = Eigen::Matrix<double, N, R>::Zero();
+    for (int i = 0; i < V; ++i)
+      for (int k = 0; k < V - 1; ++k)
+        full.template block<3, 3>(3 * i, 3 * k) = h(i, k) * Mat3::Identity();
+    return full;
+  }();
+  Eigen::Matrix<double, R, R> reduced = q.transpose() * m * q;
+  reduced = (0.5 * (reduced + reduced.transpose())).eval();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, R, R>> eig(reduced);
+  if (eig.info() != Eigen::Success) {
+    m.setConstant(std::numeric_limits<double>::quiet_NaN());  // caught by the finiteness checks
+    return true;
+  }
+  Eigen::Matrix<double, R, 1> lambda = eig.eigenvalues();
+  if (lambda.minCoeff() >= 0.0) return false;
+  lambda = lambda.cwiseMax(0.0);
+  const Eigen::Matrix<double, N, R> qv = q * eig.eigenvectors();
+  m = qv * lambda.asDiagonal() * qv.transpose();
+  return true;
+}
+
 }  // namespace
 
 MembraneModuli membraneModuli(const Material& material) {
@@ -218,5 +259,7 @@ double bendingEnergy(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3&
 
 bool projectToPsd(Mat9& m) { return projectToPsdImpl<9>(m); }
 bool projectToPsd(Mat12& m) { return projectToPsdImpl<12>(m); }
+bool projectTranslationInvariantToPsd(Mat9& m) { return projectTranslationInvariantImpl<3>(m); }
+bool projectTranslationInvariantToPsd(Mat12& m) { return projectTranslationInvariantImpl<4>(m); }
 
 }  // namespace crumple::sim

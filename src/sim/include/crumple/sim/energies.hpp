@@ -86,4 +86,13 @@ double bendingEnergy(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3&
 bool projectToPsd(Mat9& m);
 bool projectToPsd(Mat12& m);
 
+// The same projection for the Hessian of a translation-invariant energy of
+// 3 (Mat9) or 4 (Mat12) vertices, whose rows and columns sum to zero per
+// axis: the eigenproblem is solved on the orthogonal complement of the rigid
+// translations (6 x 6, 9 x 9), which holds its whole non-zero spectrum, so
+// the result is the same nearest PSD matrix at a third to a half of the
+// cost. The translation components of the result are exactly zero.
+bool projectTranslationInvariantToPsd(Mat9& m);
+bool projectTranslationInvariantToPsd(Mat12& m);
+
 }  // namespace crumple::sim
