@@ -15,18 +15,29 @@ Mat3 skew(const Vec3& a) {
   return s;
 }
 
-template <int N>
-bool projectToPsdImpl(Eigen::Matrix<double, N, N>& m) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>> eig(m);
+// Nearest PSD matrix to m on the span of q's orthonormal columns, m being
+// zero outside it: m = Q (Q^T m Q) Q^T with negative eigenvalues of the
+// middle factor clamped. Returns true when m changed.
+template <int N, int R>
+bool projectOnBasis(Eigen::Matrix<double, N, N>& m, const Eigen::Matrix<double, N, R>& q) {
+  Eigen::Matrix<double, R, R> reduced = q.transpose() * m * q;
+  reduced = (0.5 * (reduced + reduced.transpose())).eval();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, R, R>> eig(reduced);
   if (eig.info() != Eigen::Success) {
     m.setConstant(std::numeric_limits<double>::quiet_NaN());  // caught by the finiteness checks
     return true;
   }
-  Eigen::Matrix<double, N, 1> lambda = eig.eigenvalues();
+  Eigen::Matrix<double, R, 1> lambda = eig.eigenvalues();
   if (lambda.minCoeff() >= 0.0) return false;
   lambda = lambda.cwiseMax(0.0);
-  m = eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
+  const Eigen::Matrix<double, N, R> qv = q * eig.eigenvectors();
+  m = qv * lambda.asDiagonal() * qv.transpose();
   return true;
+}
+
+template <int N>
+bool projectToPsdImpl(Eigen::Matrix<double, N, N>& m) {
+  return projectOnBasis<N, N>(m, Eigen::Matrix<double, N, N>::Identity());
 }
 
 // An orthonormal basis of the vectors of R^V (V vertices, one coordinate)
@@ -55,19 +66,7 @@ bool projectTranslationInvariantImpl(Eigen::Matrix<double, 3 * V, 3 * V>& m) {
         full.template block<3, 3>(3 * i, 3 * k) = h(i, k) * Mat3::Identity();
     return full;
   }();
-  Eigen::Matrix<double, R, R> reduced = q.transpose() * m * q;
-  reduced = (0.5 * (reduced + reduced.transpose())).eval();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, R, R>> eig(reduced);
-  if (eig.info() != Eigen::Success) {
-    m.setConstant(std::numeric_limits<double>::quiet_NaN());  // caught by the finiteness checks
-    return true;
-  }
-  Eigen::Matrix<double, R, 1> lambda = eig.eigenvalues();
-  if (lambda.minCoeff() >= 0.0) return false;
-  lambda = lambda.cwiseMax(0.0);
-  const Eigen::Matrix<double, N, R> qv = q * eig.eigenvectors();
-  m = qv * lambda.asDiagonal() * qv.transpose();
-  return true;
+  return projectOnBasis<N, R>(m, q);
 }
 
 }  // namespace
