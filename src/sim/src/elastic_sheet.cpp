@@ -229,17 +229,16 @@ struct ElasticSheet::Impl {
     return dihedralAngle(xs[static_cast<std::size_t>(h[0])], xs[static_cast<std::size_t>(h[1])],
                          xs[static_cast<std::size_t>(h[2])], xs[static_cast<std::size_t>(h[3])]);
   }
-  // Hinge k's angle at xs on the branch nearest to hingeBranch[k].
-  double continuousAngle(std::size_t k, const std::vector<Vec3>& xs) const {
-    const double raw = rawAngle(k, xs);
+  // A raw angle of hinge k moved onto the branch nearest to hingeBranch[k].
+  double onBranch(std::size_t k, double raw) const {
     return hingeBranch[k] + std::remainder(raw - hingeBranch[k], 2.0 * std::numbers::pi);
   }
-  // Deviation of hinge k from its rest angle, measured on the continuous
-  // branch, given its raw (wrapped) angle.
-  double deviation(std::size_t k, double raw) const {
-    return hingeBranch[k] + std::remainder(raw - hingeBranch[k], 2.0 * std::numbers::pi) -
-           hingeRest[k];
+  // Hinge k's angle at xs on the branch nearest to hingeBranch[k].
+  double continuousAngle(std::size_t k, const std::vector<Vec3>& xs) const {
+    return onBranch(k, rawAngle(k, xs));
   }
+  // Deviation of hinge k from its rest angle on that branch, given its raw angle.
+  double deviation(std::size_t k, double raw) const { return onBranch(k, raw) - hingeRest[k]; }
   // Moves every hinge's branch to its angle at xs (after an accepted step
   // or a teleport by the caller).
   void trackBranches(const std::vector<Vec3>& xs) {
