@@ -1,9 +1,10 @@
 #include "crumple/pipeline/inspect.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
-#include <set>
+#include <map>
 #include <utility>
 
 #include "json_writer.hpp"
@@ -16,15 +17,30 @@ FrameMetrics measureFrame(const cache::FrameRecord& frame) {
   m.time = frame.time;
   m.vertices = frame.positions.size();
   m.triangles = frame.triangles.size();
-  std::set<std::pair<int, int>> edges;
-  for (const auto& t : frame.triangles)
+  // Each edge with the (up to two) triangles beside it.
+  std::map<std::pair<int, int>, std::array<int, 2>> edges;
+  for (std::size_t t = 0; t < frame.triangles.size(); ++t)
     for (int k = 0; k < 3; ++k) {
-      const int a = t[static_cast<std::size_t>(k)], b = t[static_cast<std::size_t>((k + 1) % 3)];
-      edges.emplace(std::min(a, b), std::max(a, b));
+      const auto& tri = frame.triangles[t];
+      const int a = tri[static_cast<std::size_t>(k)],
+                b = tri[static_cast<std::size_t>((k + 1) % 3)];
+      auto [it, added] = edges.try_emplace({std::min(a, b), std::max(a, b)}, std::array{-1, -1});
+      it->second[added ? 0 : 1] = static_cast<int>(t);
     }
+  const auto normal = [&](int t) {
+    const auto& tri = frame.triangles[static_cast<std::size_t>(t)];
+    const Vec3& x0 = frame.positions[static_cast<std::size_t>(tri[0])];
+    return Vec3((frame.positions[static_cast<std::size_t>(tri[1])] - x0)
+                    .cross(frame.positions[static_cast<std::size_t>(tri[2])] - x0));
+  };
   double sum = 0.0;
   std::size_t compressed = 0;
-  for (const auto& [a, b] : edges) {
+  for (const auto& [edge, beside] : edges) {
+    const auto [a, b] = edge;
+    if (beside[1] >= 0) {
+      const Vec3 n0 = normal(beside[0]), n1 = normal(beside[1]);
+      m.maxDihedral = std::max(m.maxDihedral, std::atan2(n0.cross(n1).norm(), n0.dot(n1)));
+    }
     const double rest =
         (frame.pattern[static_cast<std::size_t>(a)] - frame.pattern[static_cast<std::size_t>(b)])
             .norm();
@@ -72,6 +88,7 @@ std::string inspectJson(const cache::CacheReader& reader) {
     j.key("c_mean").value(m.cMean);
     j.key("n_comp").value(m.nComp);
     j.key("max_strain").value(m.maxStrain);
+    j.key("max_dihedral").value(m.maxDihedral);
     j.key("handle_error").value(m.handleError);
     j.key("handles").beginArray();
     for (std::size_t h = 0; h < frame.handleTargets.size(); ++h) {
@@ -102,13 +119,14 @@ std::string inspectText(const cache::CacheReader& reader) {
                 reader.recovered() ? " (recovered: no valid footer)" : "");
   out += line;
   for (const auto& issue : reader.issues()) out += "  note: " + issue.message + "\n";
-  std::snprintf(line, sizeof line, "%6s %9s %8s %9s %10s %8s %10s %12s\n", "frame", "time[s]",
-                "verts", "tris", "c_mean", "n_comp", "max_strain", "handle_err[m]");
+  std::snprintf(line, sizeof line, "%6s %9s %8s %9s %10s %8s %10s %9s %12s\n", "frame", "time[s]",
+                "verts", "tris", "c_mean", "n_comp", "max_strain", "dihedral", "handle_err[m]");
   out += line;
   for (std::size_t i = 0; i < reader.frameCount(); ++i) {
     const auto m = measureFrame(reader.readFrame(i));
-    std::snprintf(line, sizeof line, "%6d %9.4f %8zu %9zu %10.3e %8.4f %10.3e %12.3e\n", m.frame,
-                  m.time, m.vertices, m.triangles, m.cMean, m.nComp, m.maxStrain, m.handleError);
+    std::snprintf(line, sizeof line, "%6d %9.4f %8zu %9zu %10.3e %8.4f %10.3e %9.4f %12.3e\n",
+                  m.frame, m.time, m.vertices, m.triangles, m.cMean, m.nComp, m.maxStrain,
+                  m.maxDihedral, m.handleError);
     out += line;
   }
   return out;

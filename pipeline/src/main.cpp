@@ -113,8 +113,8 @@ int main(int argc, char** argv) {
                    "accepted for farm scripts; OSMesa's rasteriser sizes its own threads "
                    "(LP_NUM_THREADS) and the images are identical either way")
       ->check(CLI::Range(1, 256));
-  auto* inspect =
-      app.add_subcommand("inspect", "Print per-frame sizes, strain and handle error of a cache.");
+  auto* inspect = app.add_subcommand(
+      "inspect", "Print per-frame sizes, strain, sharpest fold and handle error of a cache.");
   inspect->add_option("CACHE", a.cache, "a .pcache file")->required();
   inspect->add_flag("--json", a.json, "one JSON object for scripts");
 

@@ -69,6 +69,21 @@ TEST(Shot, DrapeSampleFollowsItsHandlesAndStaysFinite) {
   }
 }
 
+// `crumple inspect`'s sharpest fold: two triangles hinged on the x axis, the
+// second turned by phi about it; a lone triangle or a flat pair reads 0.
+TEST(Inspect, MaxDihedralIsTheSharpestFoldBetweenAdjacentTriangles) {
+  for (const double phi : {0.0, 0.3, 1.2, 3.0}) {
+    cache::FrameRecord f;
+    f.triangles = {{0, 1, 2}, {1, 0, 3}};
+    f.pattern = {Vec2(0, 0), Vec2(1, 0), Vec2(0.5, 1), Vec2(0.5, -1)};
+    f.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.5, 1, 0),
+                   Vec3(0.5, -std::cos(phi), std::sin(phi))};
+    EXPECT_NEAR(pipeline::measureFrame(f).maxDihedral, phi, 1e-12) << "phi " << phi;
+    f.triangles.pop_back();
+    EXPECT_EQ(pipeline::measureFrame(f).maxDihedral, 0.0);
+  }
+}
+
 TEST(Shot, HandlesTrackTheirCurvesForEveryFormat) {
   // One animation written as glTF, FBX and COLLADA (tests/io/data): the
   // cached handle vertex follows the imported track to 1e-6 m at every frame,

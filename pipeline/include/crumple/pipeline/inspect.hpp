@@ -1,6 +1,7 @@
 #pragma once
 // Per-frame measures of a cached shot (`crumple inspect`): sizes, edge strain
-// against the pattern (c_mean and n_comp as in paper Table IV), handle error.
+// against the pattern (c_mean and n_comp as in paper Table IV), sharpest
+// fold between adjacent triangles, handle error.
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@ struct FrameMetrics {
   double cMean = 0.0;        // mean |l - L| / L over edges (paper Table IV, c_mean)
   double nComp = 0.0;        // share of edges with (L - l) / L > 1% (paper Table IV, n_comp)
   double maxStrain = 0.0;    // max |l - L| / L over edges
+  double maxDihedral = 0.0;  // largest angle (rad) between the normals of adjacent triangles
   double handleError = 0.0;  // max distance between a held vertex and its track (m)
   std::size_t singularVertices = 0;
   std::size_t junctionVertices = 0;
