@@ -12,6 +12,10 @@ find_package(tomlplusplus REQUIRED CONFIG)  # target tomlplusplus::tomlplusplus
 # PRIVATE: only src/mesh/src/delaunay.cpp includes CGAL.
 set(CGAL_DO_NOT_WARN_ABOUT_CMAKE_BUILD_TYPE TRUE)
 find_package(CGAL 5.5 REQUIRED CONFIG)
+# Embree 3 (the path tracer; target `embree`, header <embree3/rtcore.h>).
+find_package(embree 3.13 REQUIRED CONFIG)
+# OpenEXR 3.1 (linear frames; targets OpenEXR::OpenEXR).
+find_package(OpenEXR 3.1 REQUIRED CONFIG)
 # OSMesa only: linking libGL as well turns every GL call into a no-op.
 pkg_check_modules(OSMESA REQUIRED IMPORTED_TARGET osmesa)
 

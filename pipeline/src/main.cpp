@@ -11,10 +11,14 @@
 
 #include "crumple/core/error.hpp"
 #include "crumple/core/parallel.hpp"
+#include "crumple/exporters/exr.hpp"
 #include "crumple/exporters/pcache.hpp"
+#include "crumple/exporters/png.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/shot.hpp"
+#include "crumple/render/embree_renderer.hpp"
+#include "crumple/render/image_compare.hpp"
 
 namespace {
 
@@ -28,9 +32,65 @@ struct Args {
   std::optional<std::uint64_t> seed;
   int threads = 1;
   std::string backend = "osmesa";
+  int spp = 16;
+  int bounces = 4;
+  std::string pass = "beauty";
+  bool exr = false;
+  bool noPng = false;
+  bool contactSheet = false;
+  bool movie = false;
   bool json = false;
   bool debugStructure = false;
+  // compare
+  std::string imageA, imageB, metric = "flip", diff;
+  double tolerance = 0.05;
 };
+
+pipeline::RenderSettings renderSettings(const Args& a) {
+  pipeline::RenderSettings r;
+  if (a.backend == "embree")
+    r.backend = pipeline::RenderSettings::Backend::Embree;
+  else if (a.backend == "osmesa")
+    r.backend = pipeline::RenderSettings::Backend::Osmesa;
+  else
+    throw InputError("--backend", "'" + a.backend + "' is not a backend (osmesa or embree)");
+  r.samplesPerPixel = a.spp;
+  r.maxBounces = a.bounces;
+  if (a.pass == "albedo")
+    r.pass = render::RenderPass::Albedo;
+  else if (a.pass != "beauty")
+    throw InputError("--pass", "'" + a.pass + "' is not a pass (beauty or albedo)");
+  r.exr = a.exr;
+  r.png = !a.noPng;
+  if (!r.png && !r.exr) throw InputError("--no-png", "needs --exr (otherwise nothing is written)");
+  r.contactSheet = a.contactSheet;
+  r.movie = a.movie;
+  return r;
+}
+
+// Options shared by `run` and `render`: how the frames are drawn.
+void addRenderOptions(CLI::App* cmd, Args& a) {
+  cmd->add_option("--backend", a.backend,
+                  "renderer: osmesa (the fast preview rasteriser) or embree (the path tracer)")
+      ->capture_default_str();
+  cmd->add_option("--spp", a.spp, "embree: samples per pixel")
+      ->check(CLI::Range(1, 1 << 20))
+      ->capture_default_str();
+  cmd->add_option("--bounces", a.bounces, "embree: diffuse bounces after the first hit")
+      ->check(CLI::Range(0, 64))
+      ->capture_default_str();
+  cmd->add_option("--pass", a.pass,
+                  "beauty (lit) or albedo (the unlit surface colour the two backends agree on)")
+      ->capture_default_str();
+  cmd->add_flag("--exr", a.exr, "also write NNNN.exr (linear, premultiplied alpha, half floats)");
+  cmd->add_flag("--no-png", a.noPng, "do not write NNNN.png (with --exr)");
+  cmd->add_flag("--contact-sheet", a.contactSheet,
+                "write contact_sheet.png beside the frames folder: a grid of up to 36 of the "
+                "rendered frames, evenly spaced, labelled with their numbers");
+  cmd->add_flag("--movie", a.movie,
+                "write preview.mp4 beside the frames folder with ffmpeg (H.264), with sound.wav "
+                "muxed in when the shot has one; says so when ffmpeg is not installed");
+}
 
 int runOrSimulate(const Args& a, bool render) {
   setThreadCount(a.threads);
@@ -41,6 +101,7 @@ int runOrSimulate(const Args& a, bool render) {
   options.seed = a.seed;
   options.render = render;
   options.debugStructure = a.debugStructure;
+  if (render) options.rendering = renderSettings(a);
   const auto report = pipeline::runShot(scene, options);
   std::fputs(pipeline::summaryText(report).c_str(), stdout);
   return 0;
@@ -48,17 +109,59 @@ int runOrSimulate(const Args& a, bool render) {
 
 int renderCommand(const Args& a) {
   setThreadCount(a.threads);
-  if (a.backend != "osmesa")
-    throw InputError("--backend",
-                     "'" + a.backend + "' is not available yet; this build renders with osmesa");
   pipeline::RenderOptions options;
+  options.rendering = renderSettings(a);
   if (!a.frames.empty()) options.frames = pipeline::parseFrameRange(a.frames);
   options.framesDir = a.out;
   options.debugStructure = a.debugStructure;
   const auto report = pipeline::renderCache(a.cache, options);
-  std::printf("%d frames rendered (osmesa), %.2f ms/frame\n  frames:  %s/\n", report.framesRendered,
-              report.cost.msPerFrame(), report.framesDir.c_str());
+  std::printf("%d frames rendered (%s), %.2f ms/frame\n  frames:  %s/\n", report.framesRendered,
+              pipeline::backendName(options.rendering.backend), report.cost.msPerFrame(),
+              report.framesDir.c_str());
+  if (!report.contactSheetPath.empty())
+    std::printf("  contact sheet: %s\n", report.contactSheetPath.c_str());
+  if (!report.moviePath.empty()) std::printf("  movie:   %s\n", report.moviePath.c_str());
+  for (const auto& n : report.notes) std::printf("  note: %s\n", n.c_str());
   return 0;
+}
+
+// Reads a PNG, or an EXR converted to 8-bit sRGB (straight alpha).
+ImageRGBA8 readImage(const std::string& path) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext == ".exr" || ext == ".EXR")
+    return render::toSrgb8(exporters::readExr(path), Vec3::Zero());
+  return exporters::readPng(path);
+}
+
+int compareCommand(const Args& a) {
+  render::ImageMetric metric = render::ImageMetric::Flip;
+  if (a.metric == "mae")
+    metric = render::ImageMetric::Mae;
+  else if (a.metric == "psnr")
+    metric = render::ImageMetric::Psnr;
+  else if (a.metric != "flip")
+    throw InputError("--metric", "'" + a.metric + "' is not a metric (mae, psnr or flip)");
+  const ImageRGBA8 ia = readImage(a.imageA);
+  const ImageRGBA8 ib = readImage(a.imageB);
+  if (ia.width != ib.width || ia.height != ib.height)
+    throw InputError(a.imageB, "is " + std::to_string(ib.width) + "x" + std::to_string(ib.height) +
+                                   ", " + a.imageA + " is " + std::to_string(ia.width) + "x" +
+                                   std::to_string(ia.height));
+  const auto c = render::compareImages(ia, ib, metric);
+  const std::string diffPath =
+      !a.diff.empty() ? a.diff
+                      : (std::filesystem::path(a.imageB).parent_path() /
+                         (std::filesystem::path(a.imageB).stem().string() + ".diff.png"))
+                            .string();
+  exporters::writePng(diffPath, c.diff);
+  const bool ok = render::passes(c, metric, a.tolerance);
+  std::printf(
+      "%s %s: %.6g (tolerance %.6g, %s); mean |RGB difference| %.4g/255, alpha IoU %.6f\n"
+      "  diff: %s\n",
+      ok ? "PASS" : "FAIL", a.metric.c_str(), c.value, a.tolerance,
+      metric == render::ImageMetric::Psnr ? "higher is better" : "lower is better", c.maeRgb,
+      c.alphaIoU, diffPath.c_str());
+  return ok ? 0 : 1;
 }
 
 int inspectCommand(const Args& a) {
@@ -78,8 +181,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   Args a;
 
-  auto* run =
-      app.add_subcommand("run", "Simulate a shot, write its cache and render its frames (OSMesa).");
+  auto* run = app.add_subcommand("run", "Simulate a shot, write its cache and render its frames.");
   auto* simulate = app.add_subcommand("simulate", "Simulate a shot and write its cache only.");
   for (auto* cmd : {run, simulate}) {
     cmd->add_option("SCENE", a.scene, "scene.toml, or a folder holding one")->required();
@@ -95,6 +197,7 @@ int main(int argc, char** argv) {
     cmd->add_option("--threads", a.threads, "worker threads; results are identical for any count")
         ->check(CLI::Range(1, 256));
   }
+  addRenderOptions(run, a);
   run->add_flag(
       "--debug-structure", a.debugStructure,
       "draw the crumpling model's structure: flat regions green, curved regions magenta "
@@ -105,14 +208,29 @@ int main(int argc, char** argv) {
                    "draw the crumpling model's structure (see `run --help`)");
   render->add_option("CACHE", a.cache, "a .pcache file")->required();
   render->add_option("--frames", a.frames, "A-B: frames to render (default: every cached frame)");
-  render->add_option("--backend", a.backend, "renderer: osmesa (the only backend in this build)")
-      ->capture_default_str();
+  addRenderOptions(render, a);
   render->add_option("--out", a.out, "frames folder (default: frames/ beside the cache)");
   render
       ->add_option("--threads", a.threads,
-                   "accepted for farm scripts; OSMesa's rasteriser sizes its own threads "
-                   "(LP_NUM_THREADS) and the images are identical either way")
+                   "embree: worker threads (the images are identical for any count); osmesa: "
+                   "the rasteriser sizes its own threads (LP_NUM_THREADS), identical images too")
       ->check(CLI::Range(1, 256));
+  auto* compare = app.add_subcommand(
+      "compare",
+      "Compare two images (PNG, or EXR as sRGB) for golden-image tests: exit 0 when within "
+      "the tolerance, 1 when not, 2 on bad input; writes a diff image.");
+  compare->add_option("A", a.imageA, "reference image")->required();
+  compare->add_option("B", a.imageB, "image under test")->required();
+  compare
+      ->add_option("--metric", a.metric,
+                   "mae: mean |difference| over RGBA in 8-bit units; psnr: dB over RGBA; flip: "
+                   "mean LDR-FLIP error in [0, 1] (Andersson et al. 2020) of the images over grey")
+      ->capture_default_str();
+  compare
+      ->add_option("--tolerance", a.tolerance,
+                   "pass when mae/flip <= tolerance, or psnr >= tolerance")
+      ->capture_default_str();
+  compare->add_option("--diff", a.diff, "diff image path (default: B's folder, <B>.diff.png)");
   auto* inspect = app.add_subcommand(
       "inspect", "Print per-frame sizes, strain, sharpest fold and handle error of a cache.");
   inspect->add_option("CACHE", a.cache, "a .pcache file")->required();
@@ -136,6 +254,7 @@ int main(int argc, char** argv) {
     if (*simulate) return runOrSimulate(a, false);
     if (*render) return renderCommand(a);
     if (*inspect) return inspectCommand(a);
+    if (*compare) return compareCommand(a);
   } catch (const InputError& e) {
     std::fprintf(stderr, "crumple: error: %s\n", e.what());
     return 2;

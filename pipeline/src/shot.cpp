@@ -23,6 +23,7 @@
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/render/osmesa_renderer.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
+#include "frame_output.hpp"
 #include "json_writer.hpp"
 
 namespace crumple::pipeline {
@@ -37,12 +38,6 @@ double msSince(Clock::time_point start) {
 
 // Animation time of a frame: f / fps, the DCC convention (docs/SCENE.md "Time").
 double frameTime(const io::SceneSpec& scene, int frame) { return scene.frameTime(frame); }
-
-std::string frameFileName(int frame) {
-  char name[32];
-  std::snprintf(name, sizeof name, "%04d.png", frame);
-  return name;
-}
 
 // Creates the folder and checks that a file can be written in it.
 void prepareOutputDir(const std::string& dir, const std::string& what) {
@@ -98,66 +93,27 @@ mesh::SheetMesh sheetOfFrame(const cache::FrameRecord& frame) {
   return m;
 }
 
-// Renders cached frames with one OSMesa context, reused across frames.
-class FrameRenderer {
- public:
-  FrameRenderer(const io::SceneSpec& scene, std::string framesDir, bool debugStructure)
-      : scene_(scene),
-        framesDir_(std::move(framesDir)),
-        debugStructure_(debugStructure),
-        renderer_(scene.camera.width, scene.camera.height),
-        texture_(render::makeRuledPaperTexture(512, 512)) {}
-
-  void render(const cache::FrameRecord& frame) {
-    auto view = makeRenderScene(scene_, frame.camera);
-    view.paper.texture = texture_;
-    // Texture spans the pattern's bounding box.
-    Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-    for (const auto& p : frame.pattern) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-    view.paper.textureSize = (hi - lo).cwiseMax(Vec2::Constant(1e-6));
-    const mesh::SheetMesh sheet = sheetOfFrame(frame);
-    if (debugStructure_) {
-      const render::StructureOverlay overlay = structureOverlay(frame);
-      const auto image = renderer_.render(view, sheet, &overlay);
-      exporters::writePng((fs::path(framesDir_) / frameFileName(frame.frame)).string(), image);
-      return;
-    }
-    const auto image = renderer_.render(view, sheet);
-    exporters::writePng((fs::path(framesDir_) / frameFileName(frame.frame)).string(), image);
+// After the frames: the contact sheet (DIR/contact_sheet.png) and the movie
+// (DIR/preview.mp4, with DIR/sound.wav when there is one), DIR being the
+// shot's folder.
+void finishFrames(const std::string& framesDir, const FrameRange& range, double fps,
+                  const std::string& shotDir, const RenderSettings& settings,
+                  std::string& contactSheetPath, std::string& moviePath,
+                  std::vector<std::string>& notes) {
+  const fs::path dir = shotDir.empty() ? fs::path(".") : fs::path(shotDir);
+  if (settings.contactSheet) {
+    contactSheetPath = (dir / "contact_sheet.png").string();
+    (void)detail::writeContactSheet(framesDir, range.first, range.last, contactSheetPath);
   }
-
- private:
-  // The structure view (paper Fig. 2): flat regions green, curved regions
-  // magenta with their rulings, singular vertices red, junction vertices
-  // yellow, handles black.
-  static render::StructureOverlay structureOverlay(const cache::FrameRecord& frame) {
-    const render::StructurePalette palette;
-    render::StructureOverlay overlay;
-    for (int region : frame.regionOfTriangle) {
-      const bool curved = static_cast<std::size_t>(region) < frame.regionTypes.size() &&
-                          frame.regionTypes[static_cast<std::size_t>(region)] ==
-                              static_cast<std::uint8_t>(mesh::RegionType::Curved);
-      overlay.triangleColors.push_back(curved ? palette.curved : palette.flat);
-    }
-    const auto at = [&](int v) { return frame.positions[static_cast<std::size_t>(v)]; };
-    for (const auto& r : frame.rulings)
-      overlay.lines.push_back({at(r[0]), at(r[1]), palette.ruling});
-    for (int v : frame.junctionVertices) overlay.points.push_back({at(v), palette.junction});
-    for (int v : frame.singularVertices) overlay.points.push_back({at(v), palette.singular});
-    for (int v : frame.handleVertices)
-      if (v >= 0) overlay.points.push_back({at(v), palette.handle});
-    return overlay;
+  if (settings.movie) {
+    std::string note;
+    const std::string movie = (dir / "preview.mp4").string();
+    if (detail::makeMovie(framesDir, range.first, range.last, fps, (dir / "sound.wav").string(),
+                          movie, note))
+      moviePath = movie;
+    if (!note.empty()) notes.push_back(note);
   }
-
-  const io::SceneSpec& scene_;
-  std::string framesDir_;
-  bool debugStructure_ = false;
-  render::OsmesaRenderer renderer_;
-  ImageRGBA8 texture_;
-};
+}
 
 // Above this mean edge-length error (c_mean) a hybrid shot warns: the
 // model's target is 0.5 % (issue 3; paper Table IV reaches 0.17-1.47 %).
@@ -311,24 +267,138 @@ render::RenderScene makeRenderScene(const io::SceneSpec& scene, const cache::Cam
   view.camera.yfov = camera.yfov > 0.0 ? camera.yfov : scene.camera.yfov;
   view.camera.width = scene.camera.width;
   view.camera.height = scene.camera.height;
+  if (scene.camera.fStop > 0.0) {
+    // Thin lens: focal length from the field of view and the sensor width.
+    const double aspect = static_cast<double>(view.camera.width) / view.camera.height;
+    const double focal =
+        scene.camera.sensorWidth / aspect / (2.0 * std::tan(0.5 * view.camera.yfov));
+    view.camera.apertureRadius = focal / (2.0 * scene.camera.fStop);
+    view.camera.focusDistance = scene.camera.focusDistance > 0.0 ? scene.camera.focusDistance
+                                : scene.camera.node.empty()
+                                    ? (scene.camera.lookAt - scene.camera.position).norm()
+                                    : 1.0;
+  }
   for (const auto& l : scene.lights) {
     render::Light light;
-    light.kind = l.kind == io::LightSpec::Kind::Directional ? render::Light::Kind::Directional
-                                                            : render::Light::Kind::Point;
+    switch (l.kind) {
+      case io::LightSpec::Kind::Directional:
+        light.kind = render::Light::Kind::Directional;
+        break;
+      case io::LightSpec::Kind::Point:
+        light.kind = render::Light::Kind::Point;
+        break;
+      case io::LightSpec::Kind::Area:
+        light.kind = render::Light::Kind::Area;
+        break;
+    }
     light.direction = l.direction;
     light.position = l.position;
     light.color = l.color;
     light.intensity = l.intensity;
+    light.angle = l.angle;
+    light.size = l.size;
     light.shadow = l.shadow;
     view.lights.push_back(light);
   }
+  view.environment.color = scene.environment.color;
+  view.environment.intensity = scene.environment.intensity;
   view.ground.enabled = scene.ground.enabled;
   view.ground.height = scene.ground.height;
   view.ground.size = scene.ground.size;
   view.ground.color = scene.ground.color;
   view.paper.frontColor = scene.paper.frontColor;
   view.paper.backColor = scene.paper.backColor;
+  view.paper.transmittance =
+      scene.look.transmittance.value_or(render::paperTransmittance(scene.paper.thickness));
+  view.paper.creaseAngle = scene.look.creaseAngle;
   return view;
+}
+
+namespace {
+
+// An axis-aligned box as 12 outward-facing triangles.
+render::PropMesh boxProp(const io::PropSpec& p) {
+  render::PropMesh m;
+  m.name = p.name;
+  m.color = p.color;
+  const Vec3 h = 0.5 * p.boxSize;
+  for (int i = 0; i < 8; ++i)
+    m.vertices.push_back(p.position + Vec3((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(),
+                                           (i & 4) ? h.z() : -h.z()));
+  m.triangles = {{0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}, {0, 1, 5}, {0, 5, 4},
+                 {2, 6, 7}, {2, 7, 3}, {0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}};
+  return m;
+}
+
+}  // namespace
+
+FrameViewBuilder::FrameViewBuilder(const io::SceneSpec& scene) : scene_(scene) {
+  if (!scene.look.texture.empty()) {
+    try {
+      texture_ = exporters::readPng(scene.look.texture);
+    } catch (const InputError& e) {
+      throw InputError(scene.file, scene.look.textureLine, "paper.texture", e.what());
+    }
+  } else {
+    texture_ = render::makeRuledPaperTexture(512, 512);
+  }
+  bool meshProps = false;
+  for (const auto& p : scene.props) {
+    if (p.node.empty())
+      boxes_.push_back(boxProp(p));
+    else
+      meshProps = true;
+  }
+  if (meshProps) {
+    // Mesh props move with their nodes: the animation file is read here (it
+    // must be reachable from where the frames are rendered).
+    animation_ =
+        std::make_shared<const io::AnimationScene>(io::AnimationScene::load(scene.animationFile));
+    io::checkAnimationNodes(scene, *animation_);
+    for (const auto& p : scene.props)
+      if (!p.node.empty()) {
+        const auto m = animation_->mesh(p.node);
+        render::PropMesh rest;
+        rest.name = p.name;
+        rest.color = p.color;
+        rest.vertices = m->vertices;
+        rest.triangles = m->triangles;
+        meshPropsAtRest_.push_back(std::move(rest));
+      }
+  }
+}
+
+FrameView FrameViewBuilder::build(const cache::FrameRecord& frame) const {
+  FrameView fv;
+  fv.scene = makeRenderScene(scene_, frame.camera);
+  fv.scene.paper.texture = texture_;
+  if (scene_.look.textureSize.x() > 0.0) {
+    fv.scene.paper.textureSize = scene_.look.textureSize;
+  } else {
+    // The texture spans the pattern's bounding box.
+    Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const auto& p : frame.pattern) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    fv.scene.paper.textureSize = (hi - lo).cwiseMax(Vec2::Constant(1e-6));
+  }
+  fv.scene.props = boxes_;
+  if (animation_) {
+    std::size_t k = 0;
+    for (const auto& p : scene_.props) {
+      if (p.node.empty()) continue;
+      // The mesh is world space at t = 0: carry it along the node's motion.
+      const Mat4 motion = animation_->worldMatrix(p.node, frame.time) *
+                          animation_->worldMatrix(p.node, 0.0).inverse();
+      render::PropMesh m = meshPropsAtRest_[k++];
+      for (Vec3& v : m.vertices) v = (motion * v.homogeneous()).head<3>();
+      fv.scene.props.push_back(std::move(m));
+    }
+  }
+  fv.scene.sharpVertices = frame.singularVertices;
+  fv.sheet = sheetOfFrame(frame);
+  return fv;
 }
 
 ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
@@ -390,11 +460,13 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   // Said now as well as in the summary: they often explain a failure that follows.
   for (const auto& w : report.warnings) std::fprintf(options.log, "warning: %s\n", w.c_str());
   report.summaryPath = (fs::path(report.outDir) / "summary.json").string();
-  std::unique_ptr<FrameRenderer> renderer;
+  std::unique_ptr<detail::FrameRenderer> renderer;
   if (render) {
     report.framesDir = (fs::path(report.outDir) / "frames").string();
     prepareOutputDir(report.framesDir, "frames");
-    renderer = std::make_unique<FrameRenderer>(scene, report.framesDir, options.debugStructure);
+    renderer = std::make_unique<detail::FrameRenderer>(
+        scene, report.framesDir, options.debugStructure, options.rendering, seed);
+    report.renderBackend = backendName(options.rendering.backend);
   }
 
   std::optional<sim::ElasticSheet> elastic;
@@ -544,6 +616,10 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   }
   progress.finish();
   writer.close();
+  if (renderer && report.framesRendered > 0)
+    finishFrames(report.framesDir, FrameRange{std::max(range.first, scene.frameStart), range.last},
+                 scene.fps, report.outDir, options.rendering, report.contactSheetPath,
+                 report.moviePath, report.notes);
   report.hybrid = hybridModel;
   if (report.framesSimulated > 0) report.meanCMean /= report.framesSimulated;
   if (hybridModel && report.maxCMean > kLengthErrorWarning) {
@@ -586,10 +662,13 @@ RenderReport renderCache(const std::string& cachePath, const RenderOptions& opti
                          " is outside the cached frames " + std::to_string(firstCached) + "-" +
                          std::to_string(lastCached));
   }
+  if ((options.rendering.contactSheet || options.rendering.movie) && !options.rendering.png)
+    throw InputError("--contact-sheet/--movie", "need the PNG frames (drop --no-png)");
   prepareOutputDir(report.framesDir, "frames");
-  FrameRenderer renderer(scene, report.framesDir, options.debugStructure);
-  Progress progress("crumple render", range.last - range.first + 1, options.log,
-                    options.interactive);
+  detail::FrameRenderer renderer(scene, report.framesDir, options.debugStructure, options.rendering,
+                                 header.seed);
+  Progress progress(std::string("crumple render (") + backendName(options.rendering.backend) + ")",
+                    range.last - range.first + 1, options.log, options.interactive);
   for (int f = range.first; f <= range.last; ++f) {
     const auto frame = reader.readFrame(static_cast<std::size_t>(f - firstCached));
     const auto start = Clock::now();
@@ -600,7 +679,13 @@ RenderReport renderCache(const std::string& cachePath, const RenderOptions& opti
     progress.update(f - range.first + 1);
   }
   progress.finish();
+  finishFrames(report.framesDir, range, scene.fps, fs::path(cachePath).parent_path().string(),
+               options.rendering, report.contactSheetPath, report.moviePath, report.notes);
   return report;
+}
+
+const char* backendName(RenderSettings::Backend backend) {
+  return backend == RenderSettings::Backend::Embree ? "embree" : "osmesa";
 }
 
 std::string summaryText(const ShotReport& r) {
@@ -623,7 +708,10 @@ std::string summaryText(const ShotReport& r) {
   out += line;
   out += "  cache:   " + r.cachePath + "\n";
   if (!r.framesDir.empty()) out += "  frames:  " + r.framesDir + "/\n";
+  if (!r.contactSheetPath.empty()) out += "  contact sheet: " + r.contactSheetPath + "\n";
+  if (!r.moviePath.empty()) out += "  movie:   " + r.moviePath + "\n";
   out += "  summary: " + r.summaryPath + "\n";
+  for (const auto& n : r.notes) out += "  note: " + n + "\n";
   for (const auto& w : r.warnings) out += "  warning: " + w + "\n";
   return out;
 }
@@ -656,7 +744,8 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
   j.key("self_contact").value(false);
   j.key("tearing").value(false);
   j.key("sound").value(false);
-  j.key("render_osmesa").value(r.framesRendered > 0);
+  j.key("render_osmesa").value(r.framesRendered > 0 && r.renderBackend == "osmesa");
+  j.key("render_embree").value(r.framesRendered > 0 && r.renderBackend == "embree");
   j.endObject();
   j.key("ms_per_frame").beginObject();
   for (const auto& [name, cost] : r.stages) j.key(name).value(cost.msPerFrame());

@@ -424,10 +424,10 @@ TEST(SceneErrors, Lights) {
   expectError(kSheet + "[[lights]]\ntype = \"spot\"\n", 5, "lights[0].type",
               {"unknown light type 'spot'"});
   expectError(kSheet + "[[lights]]\nposition = [0, 1, 0]\n", 5, "lights[0].position",
-              {"only for point lights"});
+              {"only for point and area lights"});
   expectError(
       kSheet + "[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n", 7,
-      "lights[0].direction", {"only for directional lights"});
+      "lights[0].direction", {"only for directional, sun and area lights"});
   expectError(kSheet + "[[lights]]\nintensity = -1\n", 5, "lights[0].intensity", {">= 0"});
   expectError(kSheet + "[[lights]]\nname = \"a\"\n[[lights]]\nname = \"a\"\n", 7, "lights[1].name",
               {"duplicate light name 'a'"});
@@ -685,6 +685,78 @@ TEST(Samples, PaperTypesDifferOnlyInEpsC) {
   EXPECT_EQ(a.animationFile, c.animationFile);
   EXPECT_EQ(a.handles.size(), c.handles.size());
   EXPECT_DOUBLE_EQ(a.model.hybrid.sigma, c.model.hybrid.sigma);
+}
+
+}  // namespace
+}  // namespace crumple::io
+
+// --- rendering keys (issue 4) --------------------------------------------------
+
+namespace crumple::io {
+namespace {
+
+TEST(SceneRendering, LightsEnvironmentPropsLookAndDepthOfField) {
+  const SceneSpec s = parse("[scene]\nunits = \"cm\"\n" + kSheet + R"(
+[paper]
+texture_size = [20, 30]
+transmittance = 0.3
+crease_deg = 45
+[camera]
+position = [0, 30, 60]
+look_at = [0, 0, 0]
+focal_mm = 50
+f_stop = 2.8
+[[lights]]
+type = "sun"
+direction = [0, -1, 0]
+[[lights]]
+type = "area"
+position = [0, 50, 0]
+direction = [0, -1, 0]
+size = [20, 10]
+intensity = 2
+[environment]
+color = [0.5, 0.6, 0.7]
+intensity = 0.5
+[[props]]
+shape = "box"
+size = [10, 4, 10]
+position = [30, 2, 0]
+color = [0.2, 0.3, 0.4]
+)");
+  ASSERT_EQ(s.lights.size(), 2u);
+  EXPECT_EQ(s.lights[0].kind, LightSpec::Kind::Directional);
+  EXPECT_NEAR(s.lights[0].angle, 0.53 * kPi / 180.0, 1e-12) << "a sun has the sun's disc";
+  EXPECT_EQ(s.lights[1].kind, LightSpec::Kind::Area);
+  EXPECT_TRUE(s.lights[1].size.isApprox(Vec2(0.2, 0.1)));
+  EXPECT_TRUE(s.lights[1].position.isApprox(Vec3(0.0, 0.5, 0.0)));
+  EXPECT_TRUE(s.environment.color.isApprox(Vec3(0.5, 0.6, 0.7)));
+  EXPECT_DOUBLE_EQ(s.environment.intensity, 0.5);
+  ASSERT_EQ(s.props.size(), 1u);
+  EXPECT_EQ(s.props[0].name, "prop0");
+  EXPECT_TRUE(s.props[0].boxSize.isApprox(Vec3(0.1, 0.04, 0.1)));
+  EXPECT_TRUE(s.props[0].position.isApprox(Vec3(0.3, 0.02, 0.0)));
+  EXPECT_TRUE(s.look.textureSize.isApprox(Vec2(0.2, 0.3)));
+  EXPECT_DOUBLE_EQ(*s.look.transmittance, 0.3);
+  EXPECT_NEAR(s.look.creaseAngle, kPi / 4.0, 1e-12);
+  EXPECT_DOUBLE_EQ(s.camera.fStop, 2.8);
+  EXPECT_DOUBLE_EQ(s.camera.sensorWidth, 0.036);
+}
+
+TEST(SceneRendering, BadRenderingKeysNameTheirLine) {
+  expectError(kSheet + "[[lights]]\ntype = \"area\"\nposition = [0, 1, 0]\n", 4,
+              "lights[0].direction", {"missing"});
+  expectError(kSheet + "[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\nsize = [1, 1]\n", 7,
+              "lights[0].size");
+  expectError(kSheet + "[[lights]]\ntype = \"laser\"\n", 5, "lights[0].type", {"area"});
+  expectError(kSheet + "[[lights]]\ntype = \"sun\"\nangle_deg = 95\n", 6, "lights[0].angle_deg");
+  expectError(kSheet + "[paper]\ntransmittance = 1.0\n", 5, "paper.transmittance");
+  expectError(kSheet + "[paper]\ntexture = \"no-such.png\"\n", 5, "paper.texture",
+              {"no such file"});
+  expectError(kSheet + "[camera]\nfocus_distance = 2\n", 5, "camera.focus_distance", {"f_stop"});
+  expectError(kSheet + "[[props]]\nshape = \"box\"\n", 4, "props[0].size", {"missing"});
+  expectError(kSheet + "[[props]]\nnode = \"Cup\"\n", 5, "props[0].node", {"animation file"});
+  expectError(kSheet + "[environment]\nintensity = -1\n", 5, "environment.intensity");
 }
 
 }  // namespace

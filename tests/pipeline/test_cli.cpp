@@ -11,7 +11,7 @@ using namespace crumple::testing;
 TEST(Cli, HelpForEverySubcommand) {
   const auto top = runCrumple("--help");
   EXPECT_EQ(top.status, 0);
-  for (const char* sub : {"run", "simulate", "render", "inspect"}) {
+  for (const char* sub : {"run", "simulate", "render", "inspect", "compare"}) {
     EXPECT_NE(top.output.find(sub), std::string::npos) << sub;
     const auto r = runCrumple(std::string(sub) + " --help");
     EXPECT_EQ(r.status, 0) << sub;
@@ -122,6 +122,91 @@ TEST(Cli, SameSeedGivesIdenticalBytesOnOneAndTwoThreads) {
     ASSERT_FALSE(png.empty());
     EXPECT_EQ(png, readFile(tmp / "t2/frames" / name)) << name;
     EXPECT_EQ(png, readFile(tmp / "t3/frames" / name)) << name;
+  }
+}
+
+TEST(Cli, RenderWithEmbreeWritesPngAndExrIdenticallyOnAnyThreadCount) {
+  TempDir tmp;
+  writeSmallScene(tmp / "scene");
+  ASSERT_EQ(
+      runCrumple("simulate " + (tmp / "scene").string() + " --out " + (tmp / "a").string()).status,
+      0);
+  const std::string cache = (tmp / "a/cache.pcache").string();
+  for (const char* t : {"1", "2"}) {
+    const auto r =
+        runCrumple("render " + cache + " --frames 2-3 --backend embree --spp 2 --exr " +
+                   "--threads " + t + " --out " + (tmp / (std::string("e") + t)).string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("(embree)"), std::string::npos) << r.output;
+  }
+  for (const char* f : {"0002.png", "0003.png", "0002.exr", "0003.exr"}) {
+    const auto one = readFile(tmp / "e1" / f);
+    EXPECT_FALSE(one.empty()) << f;
+    EXPECT_EQ(one, readFile(tmp / "e2" / f)) << f << " differs between 1 and 2 threads";
+  }
+  EXPECT_FALSE(fs::exists(tmp / "e1/0001.png")) << "only the asked frames";
+  EXPECT_FALSE(fs::exists(tmp / "e1/0002.png.tmp")) << "no temporary left behind";
+  // Options that make no sense are refused with exit 2.
+  EXPECT_EQ(runCrumple("render " + cache + " --backend embree --spp 0").status, 2);
+  EXPECT_EQ(runCrumple("render " + cache + " --pass normals").status, 2);
+  EXPECT_EQ(runCrumple("render " + cache + " --no-png").status, 2);
+  EXPECT_EQ(runCrumple("render " + cache + " --backend embree --debug-structure").status, 2);
+}
+
+TEST(Cli, CompareExitsZeroWithinToleranceOneOutsideAndWritesADiff) {
+  TempDir tmp;
+  writeSmallScene(tmp / "scene");
+  ASSERT_EQ(runCrumple("run " + (tmp / "scene").string() + " --out " + (tmp / "a").string()).status,
+            0);
+  const std::string f2 = (tmp / "a/frames/0002.png").string();
+  const std::string f6 = (tmp / "a/frames/0006.png").string();
+  for (const char* metric : {"mae", "psnr", "flip"}) {
+    const auto same = runCrumple("compare " + f2 + " " + f2 + " --metric " + metric +
+                                 " --tolerance " + (std::string(metric) == "psnr" ? "60" : "0") +
+                                 " --diff " + (tmp / "d.png").string());
+    EXPECT_EQ(same.status, 0) << same.output;
+    EXPECT_NE(same.output.find("PASS"), std::string::npos);
+    EXPECT_TRUE(fs::exists(tmp / "d.png"));
+  }
+  // Frames 2 and 6 differ (the sheet moves): a tight tolerance fails with 1,
+  // the default diff image lands beside B.
+  const auto differ = runCrumple("compare " + f2 + " " + f6 + " --metric mae --tolerance 0.001");
+  EXPECT_EQ(differ.status, 1) << differ.output;
+  EXPECT_NE(differ.output.find("FAIL"), std::string::npos);
+  EXPECT_TRUE(fs::exists(tmp / "a/frames/0006.diff.png"));
+  EXPECT_EQ(runCrumple("compare " + f2 + " " + f6 + " --metric mae --tolerance 255").status, 0);
+  EXPECT_EQ(runCrumple("compare " + f2 + " " + (tmp / "missing.png").string()).status, 2);
+  EXPECT_EQ(runCrumple("compare " + f2 + " " + f6 + " --metric ssim").status, 2);
+}
+
+TEST(Cli, ContactSheetAndMovie) {
+  TempDir tmp;
+  writeSmallScene(tmp / "scene");
+  const auto r = runCrumple("run " + (tmp / "scene").string() + " --contact-sheet --movie --out " +
+                            (tmp / "a").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(fs::exists(tmp / "a/contact_sheet.png"));
+  EXPECT_NE(r.output.find("contact_sheet.png"), std::string::npos) << r.output;
+  const bool haveFfmpeg = runCommand("command -v ffmpeg").status == 0;
+  if (haveFfmpeg) {
+    EXPECT_TRUE(fs::exists(tmp / "a/preview.mp4")) << r.output;
+    EXPECT_GT(fs::file_size(tmp / "a/preview.mp4"), 1000u);
+    EXPECT_NE(r.output.find("silent"), std::string::npos) << "no sound.wav yet: " << r.output;
+  } else {
+    EXPECT_FALSE(fs::exists(tmp / "a/preview.mp4"));
+    EXPECT_NE(r.output.find("ffmpeg is not installed"), std::string::npos) << r.output;
+  }
+  // The movie is muxed with the shot's soundtrack when there is one.
+  if (haveFfmpeg &&
+      runCommand("ffmpeg -nostdin -loglevel error -f lavfi -i sine=frequency=440:duration=1 -y " +
+                 (tmp / "a/sound.wav").string())
+              .status == 0) {
+    const auto m = runCrumple("render " + (tmp / "a/cache.pcache").string() + " --movie");
+    ASSERT_EQ(m.status, 0) << m.output;
+    const auto probe = runCommand("ffprobe -v error -show_entries stream=codec_type -of csv=p=0 " +
+                                  (tmp / "a/preview.mp4").string());
+    EXPECT_NE(probe.output.find("audio"), std::string::npos) << probe.output;
+    EXPECT_NE(probe.output.find("video"), std::string::npos) << probe.output;
   }
 }
 

@@ -434,6 +434,198 @@ TEST(OsmesaRenderer, RejectsBadInput) {
   EXPECT_EQ(r.render(s, sheet).width, 32);
 }
 
+// --- materials, lights and passes of issue 4 --------------------------------
+
+// A white texture with a transparent window over uv [0.375, 0.625]^2: on the
+// flat sheet, world |X| < W/8 and |Z| < H/8 around the sheet's centre.
+ImageRGBA8 windowTexture() {
+  ImageRGBA8 t(64, 64);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      std::uint8_t* p = t.at(x, y);
+      p[0] = p[1] = p[2] = 255;
+      p[3] = (x >= 24 && x < 40 && y >= 24 && y < 40) ? 0 : 255;
+    }
+  return t;
+}
+
+RenderScene cutScene(const Camera& cam, bool cut) {
+  RenderScene s = shadowScene(true, cam);
+  s.environment.intensity = 0.1;
+  if (cut) s.paper.texture = windowTexture();
+  return s;
+}
+
+TEST(OsmesaRenderer, CutOutShowsWhatIsBehindAndLetsTheLightThrough) {
+  const int w = 160, h = 120;
+  OsmesaRenderer r(w, h);
+  const Camera cam = topCamera(1.0, w, h);
+  const mesh::SheetMesh sheet = flatSheet(0.2);
+  const mesh::SheetMesh none;
+  const ImageRGBA8 cut = r.render(cutScene(cam, true), sheet);
+  const ImageRGBA8 whole = r.render(cutScene(cam, false), sheet);
+  const ImageRGBA8 ground = r.render(cutScene(cam, false), none);
+  maybeDump("cutout", cut);
+  // Through the window: the ground exactly as without the paper (the light,
+  // along (1, -1, 0), reaches it past the paper's left edge).
+  const Vec3 window(0.0, 0.0, 0.0);
+  EXPECT_NEAR(luma(pixelAt(cut, cam, window)), luma(pixelAt(ground, cam, window)), 1.0);
+  EXPECT_EQ(pixelAt(cut, cam, window)[3], 255);
+  // The window's light spot on the ground, shifted by +0.2 in x: lit like
+  // open ground; just beside it, the shadow is as dark as without a window.
+  const Vec3 spot(0.2, 0.0, 0.0), beside(0.28, 0.0, 0.0);
+  EXPECT_NEAR(luma(pixelAt(cut, cam, spot)), luma(pixelAt(ground, cam, spot)), 1.0);
+  EXPECT_LT(luma(pixelAt(whole, cam, spot)), 0.6 * luma(pixelAt(ground, cam, spot)));
+  for (int k = 0; k < 4; ++k)
+    EXPECT_EQ(pixelAt(cut, cam, beside)[k], pixelAt(whole, cam, beside)[k])
+        << "no light leaks beside the cut";
+  // Paper outside the window is unchanged.
+  for (int k = 0; k < 4; ++k)
+    EXPECT_EQ(pixelAt(cut, cam, Vec3(-0.07, 0.2, 0.1))[k],
+              pixelAt(whole, cam, Vec3(-0.07, 0.2, 0.1))[k]);
+  // The window's edge falls where the texture says, to a pixel: scan along X
+  // through the centre; the paper covers |X| >= W/8.
+  const auto px = [&](double x) { return projectToPixel(cam, Vec3(x, 0.2, 0.0))->x(); };
+  const int row = static_cast<int>(std::floor(projectToPixel(cam, Vec3(0, 0.2, 0))->y()));
+  const double edge = px(kSheetWidth / 8.0);
+  for (int x = static_cast<int>(px(0.0)); x < w; ++x) {
+    const bool paper = luma(cut.at(x, row)) > luma(ground.at(x, row)) + 20.0;
+    if (x + 1.0 < edge) {
+      EXPECT_FALSE(paper) << "pixel " << x << " inside the window";
+    }
+    if (x > edge + 1.0 && x < px(0.1)) {
+      EXPECT_TRUE(paper) << "pixel " << x << " on the paper";
+    }
+  }
+}
+
+TEST(OsmesaRenderer, BackLitPaperGlowsByItsTransmittance) {
+  const int w = 64, h = 48;
+  OsmesaRenderer r(w, h);
+  const Camera cam = topCamera(1.0, w, h);
+  const mesh::SheetMesh sheet = flatSheet(0.2);
+  RenderScene s;
+  s.camera = cam;
+  Light below;
+  below.direction = Vec3(0.0, 1.0, 0.0);  // travels up: lights the back
+  s.lights = {below};
+  s.environment.intensity = 0.0;
+  s.paper.texture = whiteTexture();
+  s.paper.frontColor = s.paper.backColor = Vec3(1.0, 1.0, 1.0);
+  for (const double t : {0.0, 0.1, 0.3}) {
+    s.paper.transmittance = t;
+    const ImageRGBA8 img = r.render(s, sheet);
+    const std::uint8_t* p = pixelAt(img, cam, Vec3(0.0, 0.2, 0.0));
+    EXPECT_NEAR(p[0], linearToSrgb8(t), 1.0) << "T = " << t;
+  }
+  // Lit from the front, the paper reflects (1 - T).
+  s.lights[0].direction = Vec3(0.0, -1.0, 0.0);
+  s.paper.transmittance = 0.3;
+  EXPECT_NEAR(pixelAt(r.render(s, sheet), cam, Vec3(0.0, 0.2, 0.0))[0], linearToSrgb8(0.7), 1.0);
+}
+
+TEST(OsmesaRenderer, AreaLightIsAPointLightWithCosineFalloff) {
+  const int w = 160, h = 120;
+  OsmesaRenderer r(w, h);
+  const Camera cam = Camera::lookAt(Vec3(0.0, 3.0, 0.0), Vec3::Zero(), -Vec3::UnitZ(), 0.5, w, h);
+  RenderScene s;
+  s.camera = cam;
+  s.environment.intensity = 0.0;
+  s.ground.enabled = true;
+  s.ground.size = 2.0;
+  s.ground.color = Vec3(0.5, 0.5, 0.5);
+  Light area;
+  area.kind = Light::Kind::Area;
+  area.position = Vec3(0.0, 1.0, 0.0);
+  area.direction = Vec3(0.0, -1.0, 0.0);
+  area.size = Vec2(0.05, 0.05);
+  s.lights = {area};
+  const mesh::SheetMesh none;
+  const ImageRGBA8 img = r.render(s, none);
+  maybeDump("area_light", img);
+  // Below the light: 0.5 * I / d^2; at x = 0.5: cos^2 = 0.8 (both ends), d^2 = 1.25.
+  EXPECT_NEAR(pixelAt(img, cam, Vec3(0.0, 0.0, 0.0))[0], linearToSrgb8(0.5), 1.0);
+  EXPECT_NEAR(pixelAt(img, cam, Vec3(0.5, 0.0, 0.0))[0], linearToSrgb8(0.5 * 0.8 / 1.25), 1.0);
+}
+
+TEST(OsmesaRenderer, AlbedoPassIsUnlitTextureTimesColour) {
+  const int w = 160, h = 120;
+  OsmesaRenderer r(w, h);
+  const Camera cam = topCamera(1.0, w, h);
+  RenderScene s = shadowScene(true, cam);
+  s.paper.frontColor = Vec3(0.5, 0.25, 1.0);
+  s.ground.color = Vec3(0.2, 0.4, 0.6);
+  PropMesh box;
+  box.name = "box";
+  box.color = Vec3(0.9, 0.1, 0.1);
+  box.vertices = {{0.15, 0.0, 0.15},  {0.25, 0.0, 0.15},  {0.25, 0.0, 0.25},  {0.15, 0.0, 0.25},
+                  {0.15, 0.05, 0.15}, {0.25, 0.05, 0.15}, {0.25, 0.05, 0.25}, {0.15, 0.05, 0.25}};
+  box.triangles = {{4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4}};
+  s.props = {box};
+  const mesh::SheetMesh sheet = flatSheet(0.2);
+  const ImageRGBA8 img = r.render(s, sheet, nullptr, RenderPass::Albedo);
+  maybeDump("albedo_pass", img);
+  const std::uint8_t* paper = pixelAt(img, cam, Vec3(0.0, 0.2, 0.0));
+  EXPECT_EQ(paper[0], linearToSrgb8(0.5));
+  EXPECT_EQ(paper[1], linearToSrgb8(0.25));
+  EXPECT_EQ(paper[2], linearToSrgb8(1.0));
+  const std::uint8_t* g = pixelAt(img, cam, Vec3(-0.3, 0.0, 0.3));
+  EXPECT_EQ(g[0], linearToSrgb8(0.2));
+  EXPECT_EQ(g[2], linearToSrgb8(0.6));
+  const std::uint8_t* b = pixelAt(img, cam, Vec3(0.2, 0.05, 0.2));
+  EXPECT_EQ(b[0], linearToSrgb8(0.9));
+  EXPECT_EQ(b[1], linearToSrgb8(0.1));
+}
+
+TEST(OsmesaRenderer, PropsCastTheKeyLightsShadow) {
+  const int w = 160, h = 120;
+  OsmesaRenderer r(w, h);
+  const Camera cam = topCamera(1.0, w, h);
+  RenderScene s = shadowScene(true, cam);
+  PropMesh slab;  // a horizontal square hovering at y = 0.1 over x in [0.25, 0.35]
+  slab.name = "slab";
+  slab.vertices = {{0.25, 0.1, -0.05}, {0.35, 0.1, -0.05}, {0.35, 0.1, 0.05}, {0.25, 0.1, 0.05}};
+  slab.triangles = {{0, 2, 1}, {0, 3, 2}};
+  const mesh::SheetMesh sheet = flatSheet(0.2);
+  const ImageRGBA8 without = r.render(s, sheet);
+  s.props = {slab};
+  const ImageRGBA8 with = r.render(s, sheet);
+  maybeDump("prop_shadow", with);
+  // Light along (1, -1, 0): the slab's shadow lands 0.1 further in +x.
+  const Vec3 shadow(0.42, 0.0, 0.0);
+  EXPECT_LT(luma(pixelAt(with, cam, shadow)), 0.6 * luma(pixelAt(without, cam, shadow)));
+}
+
+TEST(OsmesaRenderer, ShadingIsSplitAcrossACreaseAndSmoothWithinACurl) {
+  // Two flat halves meeting at a 90 degree fold (the crease) seen from above
+  // at 45 degrees: each half is evenly lit, the two halves differ, and the
+  // transition is one pixel wide.
+  mesh::SheetMesh m = flatSheet(0.0, 0.02);
+  for (std::size_t i = 0; i < m.positions.size(); ++i) {
+    const double u = m.pattern[i].x() - 0.5 * kSheetWidth;
+    m.positions[i] = u <= 0.0 ? Vec3(u, 0.0, m.positions[i].z())
+                              : Vec3(0.0, u, m.positions[i].z());  // the right half stands up
+  }
+  const int w = 160, h = 120;
+  OsmesaRenderer r(w, h);
+  RenderScene s;
+  s.camera = Camera::lookAt(Vec3(-0.3, 0.3, 0.0), Vec3::Zero(), Vec3::UnitY(), 0.9, w, h);
+  Light l;
+  l.direction = Vec3(1.0, -0.3, 0.0);
+  s.lights = {l};
+  s.environment.intensity = 0.1;
+  s.paper.texture = whiteTexture();
+  const ImageRGBA8 img = r.render(s, m);
+  maybeDump("crease", img);
+  const double floor1 = luma(pixelAt(img, s.camera, Vec3(-0.03, 0.0, 0.0)));
+  const double floor2 = luma(pixelAt(img, s.camera, Vec3(-0.006, 0.0, 0.0)));
+  const double wall1 = luma(pixelAt(img, s.camera, Vec3(0.0, 0.03, 0.0)));
+  const double wall2 = luma(pixelAt(img, s.camera, Vec3(0.0, 0.006, 0.0)));
+  EXPECT_NEAR(floor1, floor2, 1.0) << "no smoothing bleeds across the crease";
+  EXPECT_NEAR(wall1, wall2, 1.0);
+  EXPECT_GT(std::abs(floor1 - wall1), 30.0);
+}
+
 TEST(OsmesaRenderer, Timing640x480) {
   const int w = 640, h = 480;
   const mesh::SheetMesh sheet = test::bentSheet(0.015, 0.011);

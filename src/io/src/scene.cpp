@@ -45,8 +45,8 @@ class SceneParser {
 
   SceneSpec parse() {
     const TableReader root(root_, "", file_);
-    root.allowOnly({"scene", "sheet", "paper", "handles", "camera", "lights", "ground", "output",
-                    "sim", "model"});
+    root.allowOnly({"scene", "sheet", "paper", "handles", "camera", "lights", "environment",
+                    "ground", "props", "output", "sim", "model"});
     // [scene] first: its `units` scales every length that follows.
     parseScene(root.subTable("scene"));
     const toml::table* sheet = root.subTable("sheet");
@@ -56,7 +56,9 @@ class SceneParser {
     parseHandles(root);
     parseCamera(root.subTable("camera"));
     parseLights(root);
+    parseEnvironment(root.subTable("environment"));
     parseGround(root.subTable("ground"));
+    parseProps(root);
     parseOutput(root.subTable("output"));
     parseSim(root.subTable("sim"));
     parseModel(root.subTable("model"));
@@ -215,13 +217,44 @@ class SceneParser {
       return;
     }
     const TableReader r(*table, "paper", file_);
-    r.allowOnly({"preset", "front_color", "back_color"});
+    r.allowOnly({"preset", "front_color", "back_color", "texture", "texture_size", "transmittance",
+                 "crease_deg"});
     if (auto preset = r.string("preset")) spec_.paperPreset = *preset;
     spec_.paper = findPreset(spec_.paperPreset,
                              [&](const std::string& problem) { r.fail("preset", problem); });
     if (auto c = r.vec3("front_color"))
       spec_.paper.frontColor = r.requireColor("front_color", *c, 1);
     if (auto c = r.vec3("back_color")) spec_.paper.backColor = r.requireColor("back_color", *c, 1);
+    PaperLookSpec& look = spec_.look;
+    if (auto t = r.string("texture")) {
+      if (t->empty()) r.fail("texture", "must not be empty");
+      look.texture = resolvePath(*t);
+      look.textureLine = r.lineOf("texture");
+      std::error_code ec;
+      if (checkFiles_ && !fs::is_regular_file(look.texture, ec))
+        r.fail("texture", "no such file: " + look.texture);
+    }
+    if (auto ts = r.vec2("texture_size")) {
+      if (!(ts->x() > 0.0 && ts->y() > 0.0)) r.fail("texture_size", "both sides must be > 0");
+      look.textureSize = *ts * mpu();
+    }
+    if (auto t = r.number("transmittance")) {
+      if (!(*t >= 0.0 && *t < 1.0))
+        r.fail("transmittance", "must be in [0, 1) (got " + formatNumber(*t) + ")");
+      look.transmittance = *t;
+    }
+    if (auto c = r.number("crease_deg")) {
+      if (!(*c > 0.0 && *c <= 180.0))
+        r.fail("crease_deg", "must be in (0, 180] degrees (got " + formatNumber(*c) + ")");
+      look.creaseAngle = *c * kPi / 180.0;
+    }
+  }
+
+  // A path relative to the scene's folder.
+  std::string resolvePath(const std::string& path) const {
+    fs::path p(path);
+    if (p.is_relative()) p = fs::path(baseDir_.empty() ? "." : baseDir_) / p;
+    return p.lexically_normal().string();
   }
 
   void parseHandles(const TableReader& root) {
@@ -282,8 +315,8 @@ class SceneParser {
   void parseCamera(const toml::table* table) {
     if (!table) return;
     const TableReader r(*table, "camera", file_);
-    r.allowOnly(
-        {"node", "position", "look_at", "up", "fov_deg", "focal_mm", "sensor_mm", "resolution"});
+    r.allowOnly({"node", "position", "look_at", "up", "fov_deg", "focal_mm", "sensor_mm",
+                 "resolution", "f_stop", "focus_distance"});
     CameraSpec& c = spec_.camera;
     if (auto res = r.intPair("resolution")) {
       for (std::int64_t v : *res) {
@@ -335,7 +368,13 @@ class SceneParser {
       // sensor_mm is the sensor width; the vertical extent follows the aspect.
       const double aspect = static_cast<double>(c.width) / static_cast<double>(c.height);
       c.yfov = 2.0 * std::atan(sensor / aspect / (2.0 * f));
+      c.sensorWidth = sensor * 1e-3;
       c.fovExplicit = true;
+    }
+    if (auto n = r.number("f_stop")) c.fStop = r.requirePositive("f_stop", *n);
+    if (auto d = r.number("focus_distance")) {
+      if (!(c.fStop > 0.0)) r.fail("focus_distance", "needs f_stop (depth of field)");
+      c.focusDistance = r.requirePositive("focus_distance", *d) * mpu();
     }
   }
 
@@ -357,32 +396,99 @@ class SceneParser {
     std::set<std::string> names;
     for (std::size_t i = 0; i < lights->size(); ++i) {
       const TableReader r(*lights->get(i)->as_table(), "lights[" + std::to_string(i) + "]", file_);
-      r.allowOnly({"name", "type", "direction", "position", "color", "intensity", "shadow"});
+      r.allowOnly({"name", "type", "direction", "position", "color", "intensity", "shadow",
+                   "angle_deg", "size"});
       LightSpec l;
       l.name = r.string("name").value_or("light" + std::to_string(i));
       if (l.name.empty()) r.fail("name", "must not be empty");
       if (!names.insert(l.name).second) r.fail("name", "duplicate light name '" + l.name + "'");
       const std::string type = r.string("type").value_or("directional");
-      if (type == "directional") {
+      if (type == "directional" || type == "sun") {
         l.kind = LightSpec::Kind::Directional;
-        if (r.has("position")) r.fail("position", "only for point lights (type = \"point\")");
+        if (r.has("position")) r.fail("position", "only for point and area lights");
+        if (r.has("size")) r.fail("size", "only for area lights (type = \"area\")");
         l.direction = l.direction.normalized();
         if (auto d = r.vec3("direction")) l.direction = r.requireDirection("direction", *d);
-      } else if (type == "point") {
-        l.kind = LightSpec::Kind::Point;
-        if (r.has("direction")) {
-          r.fail("direction", "only for directional lights (type = \"directional\")");
+        // A sun is a directional light with the sun's disc (0.53 degrees) by default.
+        double angleDeg = type == "sun" ? 0.53 : 0.0;
+        if (auto a = r.number("angle_deg")) {
+          if (!(*a >= 0.0 && *a < 90.0))
+            r.fail("angle_deg", "must be in [0, 90) degrees (got " + formatNumber(*a) + ")");
+          angleDeg = *a;
         }
+        l.angle = angleDeg * kPi / 180.0;
+      } else if (type == "point" || type == "area") {
+        l.kind = type == "point" ? LightSpec::Kind::Point : LightSpec::Kind::Area;
+        if (r.has("angle_deg")) r.fail("angle_deg", "only for directional and sun lights");
         const std::optional<Vec3> p = r.vec3("position");
         if (!p) r.missing("position");
         l.position = *p * mpu();
+        if (type == "point") {
+          if (r.has("direction")) r.fail("direction", "only for directional, sun and area lights");
+          if (r.has("size")) r.fail("size", "only for area lights (type = \"area\")");
+        } else {
+          const std::optional<Vec3> d = r.vec3("direction");
+          if (!d) r.missing("direction");
+          l.direction = r.requireDirection("direction", *d);
+          if (auto sz = r.vec2("size")) {
+            if (!(sz->x() > 0.0 && sz->y() > 0.0)) r.fail("size", "both sides must be > 0");
+            l.size = *sz * mpu();
+          }
+        }
       } else {
-        r.fail("type", "unknown light type '" + type + "' (expected directional or point)");
+        r.fail("type",
+               "unknown light type '" + type + "' (expected directional, sun, point or area)");
       }
       if (auto c = r.vec3("color")) l.color = r.requireColor("color", *c, 1.0);
       if (auto v = r.number("intensity")) l.intensity = r.requireNonNegative("intensity", *v);
       l.shadow = r.boolean("shadow").value_or(false);
       spec_.lights.push_back(std::move(l));
+    }
+  }
+
+  void parseEnvironment(const toml::table* table) {
+    if (!table) return;
+    const TableReader r(*table, "environment", file_);
+    r.allowOnly({"color", "intensity"});
+    if (auto c = r.vec3("color")) spec_.environment.color = r.requireColor("color", *c, 1.0);
+    if (auto v = r.number("intensity"))
+      spec_.environment.intensity = r.requireNonNegative("intensity", *v);
+  }
+
+  void parseProps(const TableReader& root) {
+    const toml::array* props = root.tableArray("props");
+    if (!props) return;
+    std::set<std::string> names;
+    for (std::size_t i = 0; i < props->size(); ++i) {
+      const TableReader r(*props->get(i)->as_table(), "props[" + std::to_string(i) + "]", file_);
+      r.allowOnly({"name", "node", "shape", "size", "position", "color"});
+      PropSpec p;
+      const std::string shape = r.string("shape").value_or(r.has("node") ? "mesh" : "box");
+      if (shape == "mesh") {
+        const std::optional<std::string> node = r.string("node");
+        if (!node) r.missing("node");
+        if (node->empty()) r.fail("node", "must not be empty");
+        if (spec_.animationFile.empty())
+          r.fail("node", "a mesh prop needs an animation file ([scene] animation)");
+        for (const char* key : {"size", "position"})
+          if (r.has(key)) r.fail(key, "only for shape = \"box\" (a mesh prop moves with its node)");
+        p.node = *node;
+        p.nodeLine = r.lineOf("node");
+      } else if (shape == "box") {
+        if (r.has("node")) r.fail("node", "a box has no node (use shape = \"mesh\")");
+        const std::optional<Vec3> sz = r.vec3("size");
+        if (!sz) r.missing("size");
+        if (!(sz->minCoeff() > 0.0)) r.fail("size", "every side must be > 0");
+        p.boxSize = *sz * mpu();
+        if (auto pos = r.vec3("position")) p.position = *pos * mpu();
+      } else {
+        r.fail("shape", "unknown shape '" + shape + "' (expected box or mesh)");
+      }
+      p.name = r.string("name").value_or(p.node.empty() ? "prop" + std::to_string(i) : p.node);
+      if (p.name.empty()) r.fail("name", "must not be empty");
+      if (!names.insert(p.name).second) r.fail("name", "duplicate prop name '" + p.name + "'");
+      if (auto c = r.vec3("color")) p.color = r.requireColor("color", *c, 1.0);
+      spec_.props.push_back(std::move(p));
     }
   }
 
@@ -586,6 +692,15 @@ void checkAnimationNodes(const SceneSpec& scene, const AnimationScene& animation
         throw InputError(animation.file(),
                          "node '" + scene.sheet.patternMesh + "' holds no triangle mesh");
       }
+    });
+  }
+  for (std::size_t i = 0; i < scene.props.size(); ++i) {
+    const PropSpec& p = scene.props[i];
+    if (p.node.empty()) continue;
+    check(p.nodeLine, "props[" + std::to_string(i) + "].node", [&] {
+      const std::optional<ImportedMesh> m = animation.mesh(p.node);
+      if (!m || m->triangles.empty())
+        throw InputError(animation.file(), "node '" + p.node + "' holds no triangle mesh");
     });
   }
 }

@@ -37,12 +37,12 @@ namespace crumple::render {
 namespace {
 
 constexpr int kMaxLights = 16;
-// Shadow map side: the map is fitted to the paper, so 1024 texels give ~0.3 mm
-// on an A4 sheet; large images get 2048.
+// Shadow map side: the map is fitted to the casters, so 1024 texels give
+// ~0.3 mm on an A4 sheet, finer than a pixel of a 1280 x 720 frame showing the
+// sheet; images over 2048 pixels wide get 2048 (a 2048 map costs ~10 ms).
 constexpr int kShadowMapSmall = 1024;
 constexpr int kShadowMapLarge = 2048;
 constexpr int kMaxSamples = 4;
-constexpr double kAmbientFromBackground = 0.25;
 
 // llvmpipe compiles shaders for the CPU it runs on; AVX, FMA and the vector
 // width change floating-point results in the last bit. Pinning the feature set
@@ -73,10 +73,13 @@ void main() {
 )";
 
 // Compiled per variant: NUM_LIGHTS (>= 1), KEY_LIGHT (index of the shadow
-// casting light or -1), KEY_IS_POINT, IS_GROUND, TRI_COLORS (albedo per
+// casting light or -1), KEY_IS_POINT, IS_GROUND (a plain Lambert surface of
+// colour u_groundColor: the ground and the props), TRI_COLORS (albedo per
 // triangle from a buffer texture indexed by gl_PrimitiveID, the structure
-// overlay's colours). llvmpipe executes both sides of a branch under a mask,
-// so everything not needed is compiled out.
+// overlay's colours), ALPHA_CUT (the texture's alpha < 0.5 cuts the paper),
+// TRANSMIT (the paper transmits u_transmittance of the light from its other
+// side), ALBEDO (the albedo pass: unlit). llvmpipe executes both sides of a
+// branch under a mask, so everything not needed is compiled out.
 const char* const kMainFragment = R"(
 in vec3 v_pos;
 in vec3 v_normal;
@@ -88,6 +91,8 @@ uniform samplerBuffer u_triColors;
 #endif
 uniform vec3 u_frontColor;
 uniform vec3 u_backColor;
+uniform float u_transmittance;
+uniform vec4 u_lightAreaNormal[NUM_LIGHTS];  // w = 1: an area light emitting along xyz
 uniform vec3 u_groundColor;
 uniform vec3 u_ambient;
 uniform vec3 u_cameraPos;
@@ -131,6 +136,9 @@ float keyVisibility(vec3 p, vec3 ng, vec3 L) {
 #endif
 
 void main() {
+#if ALPHA_CUT && !IS_GROUND
+  if (textureLod(u_tex, v_uv, 0.0).a < 0.5) discard;
+#endif
   vec3 ng = cross(dFdx(v_pos), dFdy(v_pos));
   float ngLen = length(ng);
   ng = ngLen > 0.0 ? ng / ngLen : vec3(0.0, 1.0, 0.0);
@@ -148,20 +156,38 @@ void main() {
   vec3 albedo = (gl_FrontFacing ? u_frontColor : u_backColor) * texture(u_tex, v_uv).rgb;
 #endif
 
+#if ALBEDO
+  o_color = vec4(encodeSrgb(albedo), 1.0);
+#else
   vec3 light = u_ambient;
+#if TRANSMIT && !IS_GROUND
+  vec3 behind = vec3(0.0);
+#endif
   for (int i = 0; i < NUM_LIGHTS; ++i) {
     vec4 lv = u_lightVec[i];
     vec3 d = lv.xyz - lv.w * v_pos;
     float d2 = max(dot(d, d), 1e-12);
     vec3 L = d * inversesqrt(d2);
     float atten = lv.w == 0.0 ? 1.0 : 1.0 / d2;
-    float ndl = max(dot(n, L), 0.0);
+    vec4 an = u_lightAreaNormal[i];
+    if (an.w > 0.0) atten *= max(dot(an.xyz, -L), 0.0);
+    float vis = 1.0;
 #if KEY_LIGHT >= 0
-    if (i == KEY_LIGHT) ndl *= keyVisibility(v_pos, ng, L);
+    if (i == KEY_LIGHT) vis = keyVisibility(v_pos, ng, L);
 #endif
-    light += u_lightRadiance[i] * (ndl * atten);
+    float ndl = max(dot(n, L), 0.0);
+    light += u_lightRadiance[i] * (ndl * atten * vis);
+#if TRANSMIT && !IS_GROUND
+    behind += u_lightRadiance[i] * (max(-dot(n, L), 0.0) * atten * vis);
+#endif
   }
+#if TRANSMIT && !IS_GROUND
+  // Of the light on this side a (1 - T) is reflected; of the light on the
+  // other side a T comes through; the ambient reaches both sides alike.
+  light = u_ambient + (1.0 - u_transmittance) * (light - u_ambient) + u_transmittance * behind;
+#endif
   o_color = vec4(encodeSrgb(albedo * light), 1.0);
+#endif
 }
 )";
 
@@ -185,12 +211,24 @@ void main() { o_color = v_color; }
 
 const char* const kShadowVertex = R"(
 layout(location = 0) in vec3 a_pos;
+layout(location = 2) in vec2 a_uv;
 uniform mat4 u_lightViewProj;
-void main() { gl_Position = u_lightViewProj * vec4(a_pos, 1.0); }
+out vec2 v_uv;
+void main() {
+  v_uv = a_uv;
+  gl_Position = u_lightViewProj * vec4(a_pos, 1.0);
+}
 )";
 
+// ALPHA_CUT: light passes where the paper is cut.
 const char* const kShadowFragment = R"(
-void main() {}
+in vec2 v_uv;
+uniform sampler2D u_tex;
+void main() {
+#if ALPHA_CUT
+  if (textureLod(u_tex, v_uv, 0.0).a < 0.5) discard;
+#endif
+}
 )";
 
 GLuint compileShader(GLenum type, const std::string& defines, const char* body) {
@@ -347,13 +385,15 @@ struct OsmesaRenderer::Impl {
   OsmesaContext context;
 
   GLuint shadowProgram = 0;
+  GLuint shadowCutProgram = 0;  // the shadow pass of a paper with cut-outs
   GLuint overlayProgram = 0;
   // Main-pass programs by variant (lights, key light, key is point, ground,
-  // triangle colours).
-  std::map<std::array<int, 5>, GLuint> mainPrograms;
+  // triangle colours, alpha cut, transmission, albedo pass).
+  std::map<std::array<int, 8>, GLuint> mainPrograms;
   int shadowSize = kShadowMapSmall;
-  GLuint paperVao = 0, paperVbo = 0, paperEbo = 0;
+  GLuint paperVao = 0, paperVbo = 0;
   GLuint groundVao = 0, groundVbo = 0;
+  GLuint propVao = 0, propVbo = 0;
   GLuint msFbo = 0, msColor = 0, msDepth = 0;
   GLuint resolveFbo = 0, resolveColor = 0;
   GLuint shadowFbo = 0, shadowTex = 0;
@@ -364,10 +404,12 @@ struct OsmesaRenderer::Impl {
 
   // The texture currently uploaded (to skip re-uploading an unchanged one).
   bool textureIsRuled = false;
+  bool textureHasCut = false;  // some texel's alpha < 0.5: the paper has cut-outs
   ImageRGBA8 uploadedTexture;
 
-  std::vector<Vertex> vertices;
-  std::vector<GLuint> indices;
+  std::vector<Vertex> vertices;      // three per sheet triangle (split shading normals)
+  std::vector<Vertex> propVertices;  // three per prop triangle, all props
+  std::vector<GLint> propFirst;      // first vertex of each prop
   std::vector<std::uint8_t> readback;
   std::vector<GLfloat> triColors;
 
@@ -402,20 +444,27 @@ struct OsmesaRenderer::Impl {
   };
 
   void createPrograms() {
-    shadowProgram = linkProgram("", kShadowVertex, kShadowFragment);
+    shadowProgram = linkProgram("#define ALPHA_CUT 0\n", kShadowVertex, kShadowFragment);
+    shadowCutProgram = linkProgram("#define ALPHA_CUT 1\n", kShadowVertex, kShadowFragment);
+    glUseProgram(shadowCutProgram);
+    glUniform1i(glGetUniformLocation(shadowCutProgram, "u_tex"), 0);
     overlayProgram = linkProgram("", kOverlayVertex, kOverlayFragment);
   }
 
-  GLuint mainProgram(int numLights, int keyLight, bool keyIsPoint, bool ground, bool triColors) {
-    const std::array<int, 5> variant = {numLights, keyLight, keyIsPoint ? 1 : 0, ground ? 1 : 0,
-                                        triColors ? 1 : 0};
+  GLuint mainProgram(int numLights, int keyLight, bool keyIsPoint, bool ground, bool triColors,
+                     bool alphaCut, bool transmit, bool albedo) {
+    const std::array<int, 8> variant = {numLights,        keyLight,          keyIsPoint ? 1 : 0,
+                                        ground ? 1 : 0,   triColors ? 1 : 0, alphaCut ? 1 : 0,
+                                        transmit ? 1 : 0, albedo ? 1 : 0};
     const auto it = mainPrograms.find(variant);
     if (it != mainPrograms.end()) return it->second;
-    const std::string defines = "#define NUM_LIGHTS " + std::to_string(numLights) +
-                                "\n#define KEY_LIGHT " + std::to_string(keyLight) +
-                                "\n#define KEY_IS_POINT " + std::to_string(variant[2]) +
-                                "\n#define IS_GROUND " + std::to_string(variant[3]) +
-                                "\n#define TRI_COLORS " + std::to_string(variant[4]) + "\n";
+    const std::string defines =
+        "#define NUM_LIGHTS " + std::to_string(numLights) + "\n#define KEY_LIGHT " +
+        std::to_string(keyLight) + "\n#define KEY_IS_POINT " + std::to_string(variant[2]) +
+        "\n#define IS_GROUND " + std::to_string(variant[3]) + "\n#define TRI_COLORS " +
+        std::to_string(variant[4]) + "\n#define ALPHA_CUT " + std::to_string(variant[5]) +
+        "\n#define TRANSMIT " + std::to_string(variant[6]) + "\n#define ALBEDO " +
+        std::to_string(variant[7]) + "\n";
     const GLuint program = linkProgram(defines, kMainVertex, kMainFragment);
     glUseProgram(program);
     glUniform1i(glGetUniformLocation(program, "u_tex"), 0);
@@ -441,16 +490,20 @@ struct OsmesaRenderer::Impl {
   void createGeometry() {
     glGenVertexArrays(1, &paperVao);
     glGenBuffers(1, &paperVbo);
-    glGenBuffers(1, &paperEbo);
     glBindVertexArray(paperVao);
     glBindBuffer(GL_ARRAY_BUFFER, paperVbo);
-    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, paperEbo);
     setupVertexLayout();
 
     glGenVertexArrays(1, &groundVao);
     glGenBuffers(1, &groundVbo);
     glBindVertexArray(groundVao);
     glBindBuffer(GL_ARRAY_BUFFER, groundVbo);
+    setupVertexLayout();
+
+    glGenVertexArrays(1, &propVao);
+    glGenBuffers(1, &propVbo);
+    glBindVertexArray(propVao);
+    glBindBuffer(GL_ARRAY_BUFFER, propVbo);
     setupVertexLayout();
 
     glGenVertexArrays(1, &overlayVao);
@@ -543,7 +596,7 @@ struct OsmesaRenderer::Impl {
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, resolveColor);
     checkFramebuffer("resolve");
 
-    shadowSize = std::max(width, height) > 1024 ? kShadowMapLarge : kShadowMapSmall;
+    shadowSize = std::max(width, height) > 2048 ? kShadowMapLarge : kShadowMapSmall;
     glGenTextures(1, &shadowTex);
     glBindTexture(GL_TEXTURE_2D, shadowTex);
     glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, shadowSize, shadowSize, 0,
@@ -582,6 +635,13 @@ struct OsmesaRenderer::Impl {
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
     textureIsRuled = ruled;
+    // Bilinear alpha is below 0.5 somewhere only if some texel's is.
+    textureHasCut = false;
+    for (std::size_t i = 3; i < tex.pixels.size(); i += 4)
+      if (tex.pixels[i] < 128) {
+        textureHasCut = true;
+        break;
+      }
     if (ruled)
       uploadedTexture = ImageRGBA8();
     else
@@ -589,7 +649,7 @@ struct OsmesaRenderer::Impl {
   }
 
   ImageRGBA8 render(const RenderScene& scene, const mesh::SheetMesh& sheet,
-                    const StructureOverlay* overlay);
+                    const StructureOverlay* overlay, RenderPass pass);
 };
 
 namespace {
@@ -612,8 +672,23 @@ void validateInput(const RenderScene& scene, const mesh::SheetMesh& sheet, int w
     if (!finite(l.color) || !std::isfinite(l.intensity) || !finite(l.position) ||
         !finite(l.direction))
       throw std::invalid_argument("OsmesaRenderer: light has non-finite parameters");
-    if (l.kind == Light::Kind::Directional && !(l.direction.norm() > 0.0))
-      throw std::invalid_argument("OsmesaRenderer: directional light with zero direction");
+    if (l.kind != Light::Kind::Point && !(l.direction.norm() > 0.0))
+      throw std::invalid_argument("OsmesaRenderer: directional or area light with zero direction");
+    if (l.kind == Light::Kind::Area && !(l.size.allFinite() && l.size.minCoeff() > 0.0))
+      throw std::invalid_argument("OsmesaRenderer: area light needs a finite size > 0");
+  }
+  if (!finite(scene.environment.color) || !std::isfinite(scene.environment.intensity))
+    throw std::invalid_argument("OsmesaRenderer: environment is not finite");
+  for (const PropMesh& prop : scene.props) {
+    for (const Vec3& v : prop.vertices)
+      if (!finite(v))
+        throw std::invalid_argument("OsmesaRenderer: prop '" + prop.name +
+                                    "' has a non-finite vertex");
+    for (const auto& t : prop.triangles)
+      for (const int v : t)
+        if (v < 0 || static_cast<std::size_t>(v) >= prop.vertices.size())
+          throw std::invalid_argument("OsmesaRenderer: prop '" + prop.name +
+                                      "' triangle index out of range");
   }
   if (scene.ground.enabled && !(std::isfinite(scene.ground.height) && scene.ground.size > 0.0 &&
                                 std::isfinite(scene.ground.size) && finite(scene.ground.color)))
@@ -622,6 +697,8 @@ void validateInput(const RenderScene& scene, const mesh::SheetMesh& sheet, int w
   if (!(paper.textureSize.x() > 0.0 && paper.textureSize.y() > 0.0) ||
       !paper.textureSize.allFinite())
     throw std::invalid_argument("OsmesaRenderer: paper textureSize must be positive");
+  if (!(paper.transmittance >= 0.0 && paper.transmittance < 1.0))
+    throw std::invalid_argument("OsmesaRenderer: paper transmittance must be in [0, 1)");
   if (!paper.texture.pixels.empty() &&
       (paper.texture.width <= 0 || paper.texture.height <= 0 ||
        paper.texture.pixels.size() !=
@@ -649,7 +726,7 @@ const ImageRGBA8& ruledTexture() {
 }  // namespace
 
 ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::SheetMesh& sheet,
-                                        const StructureOverlay* overlay) {
+                                        const StructureOverlay* overlay, RenderPass pass) {
   validateInput(scene, sheet, width, height);
   if (overlay != nullptr) {
     detail::validateOverlay(*overlay, sheet.triangles.size());
@@ -668,43 +745,62 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
   const bool hasPaper = !sheet.triangles.empty();
   const Vec3 origin = sheet.positions.empty() ? Vec3::Zero() : Vec3(0.5 * (lo + hi));
 
-  // Area-weighted vertex normals from the 3D winding (front side).
-  const std::size_t nv = sheet.positions.size();
-  std::vector<Vec3> normals(nv, Vec3::Zero());
-  for (const auto& t : sheet.triangles) {
-    const Vec3& a = sheet.positions[static_cast<std::size_t>(t[0])];
-    const Vec3& b = sheet.positions[static_cast<std::size_t>(t[1])];
-    const Vec3& c = sheet.positions[static_cast<std::size_t>(t[2])];
-    const Vec3 n = (b - a).cross(c - a);
-    for (const int v : t) normals[static_cast<std::size_t>(v)] += n;
-  }
-  vertices.resize(nv);
+  // Three vertices per triangle: the shading normals are split across
+  // creases and around sharp vertices (shadingNormals).
+  const auto cornerNormals = shadingNormals(sheet.positions, sheet.triangles,
+                                            scene.paper.creaseAngle, scene.sharpVertices);
+  const std::size_t nt = sheet.triangles.size();
+  vertices.resize(nt * 3);
   const Vec2& ts = scene.paper.textureSize;
-  for (std::size_t i = 0; i < nv; ++i) {
-    const Vec3 p = sheet.positions[i] - origin;
-    const double len = normals[i].norm();
-    const Vec3 n = len > 0.0 ? Vec3(normals[i] / len) : Vec3::Zero();
-    Vertex& v = vertices[i];
-    for (int k = 0; k < 3; ++k) {
-      v.pos[k] = static_cast<float>(p[k]);
-      v.normal[k] = static_cast<float>(n[k]);
+  for (std::size_t t = 0; t < nt; ++t)
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto i = static_cast<std::size_t>(sheet.triangles[t][k]);
+      const Vec3 p = sheet.positions[i] - origin;
+      const Vec3& n = cornerNormals[t][k];
+      // The texture's top row sits at pattern y = textureSize.y: seen from the
+      // front with the pattern's +y up, the image is upright and not mirrored.
+      const Vec2 uv = patternToUv(sheet.pattern[i], ts);
+      Vertex& v = vertices[t * 3 + k];
+      for (int c = 0; c < 3; ++c) {
+        v.pos[c] = static_cast<float>(p[c]);
+        v.normal[c] = static_cast<float>(n[c]);
+      }
+      v.uv[0] = static_cast<float>(uv.x());
+      v.uv[1] = static_cast<float>(uv.y());
     }
-    // The texture's top row sits at pattern y = textureSize.y: seen from the
-    // front with the pattern's +y up, the image is upright and not mirrored.
-    v.uv[0] = static_cast<float>(sheet.pattern[i].x() / ts.x());
-    v.uv[1] = static_cast<float>(1.0 - sheet.pattern[i].y() / ts.y());
-  }
-  indices.resize(sheet.triangles.size() * 3);
-  for (std::size_t t = 0; t < sheet.triangles.size(); ++t)
-    for (std::size_t k = 0; k < 3; ++k)
-      indices[t * 3 + k] = static_cast<GLuint>(sheet.triangles[t][k]);
-
   glBindVertexArray(paperVao);
   glBindBuffer(GL_ARRAY_BUFFER, paperVbo);
   glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)),
                vertices.data(), GL_STREAM_DRAW);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(GLuint)),
-               indices.data(), GL_STREAM_DRAW);
+
+  // Props: flat-shaded, three vertices per triangle, one draw each.
+  propVertices.clear();
+  propFirst.clear();
+  for (const PropMesh& prop : scene.props) {
+    propFirst.push_back(static_cast<GLint>(propVertices.size()));
+    for (const auto& t : prop.triangles) {
+      const Vec3 a = prop.vertices[static_cast<std::size_t>(t[0])] - origin;
+      const Vec3 b = prop.vertices[static_cast<std::size_t>(t[1])] - origin;
+      const Vec3 c = prop.vertices[static_cast<std::size_t>(t[2])] - origin;
+      const Vec3 fn = (b - a).cross(c - a);
+      const Vec3 n = fn.norm() > 0.0 ? Vec3(fn.normalized()) : Vec3::Zero();
+      for (const Vec3* q : {&a, &b, &c}) {
+        Vertex v{};
+        for (int k = 0; k < 3; ++k) {
+          v.pos[k] = static_cast<float>((*q)[k]);
+          v.normal[k] = static_cast<float>(n[k]);
+        }
+        propVertices.push_back(v);
+      }
+    }
+  }
+  propFirst.push_back(static_cast<GLint>(propVertices.size()));
+  if (!propVertices.empty()) {
+    glBindVertexArray(propVao);
+    glBindBuffer(GL_ARRAY_BUFFER, propVbo);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(propVertices.size() * sizeof(Vertex)),
+                 propVertices.data(), GL_STREAM_DRAW);
+  }
 
   // Ground: a square at Y = height centred under the paper's bounding box,
   // counter-clockwise seen from above (front face up).
@@ -741,16 +837,28 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
       break;
     }
 
+  // The paper texture (unit 0), needed by the shadow pass of a cut paper.
+  if (scene.paper.texture.pixels.empty())
+    uploadTexture(ruledTexture(), true);
+  else
+    uploadTexture(scene.paper.texture, false);
+  const bool alphaCut = textureHasCut;
+
   // --- shadow pass ------------------------------------------------------------
   Mat4 lightViewProj = Mat4::Identity();
   double shadowTexelWorld = 0.0;
   const bool shadows = key >= 0 && hasPaper;
   if (shadows) {
     const Light& kl = lights[static_cast<std::size_t>(key)];
-    // Receivers: the paper and the ground. Casters: the paper only.
+    // Casters: the paper and the props; receivers: those and the ground.
     std::vector<Vec3> receivers;
-    receivers.reserve(nv + 4);
-    for (const Vertex& v : vertices) receivers.emplace_back(v.pos[0], v.pos[1], v.pos[2]);
+    for (const Vec3& p : sheet.positions) {
+      const Vec3 q = p - origin;
+      receivers.emplace_back(static_cast<float>(q.x()), static_cast<float>(q.y()),
+                             static_cast<float>(q.z()));
+    }
+    for (const Vertex& v : propVertices) receivers.emplace_back(v.pos[0], v.pos[1], v.pos[2]);
+    const std::size_t nv = receivers.size();
     if (scene.ground.enabled)
       for (const Vec3& c : groundCorners) receivers.push_back(c);
     if (kl.kind == Light::Kind::Directional) {
@@ -778,7 +886,8 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
       lightViewProj = proj * view;
       shadowTexelWorld = (extent + 2.0 * pad) / shadowSize;
     } else {
-      // Perspective from the point light towards the paper's bounding sphere.
+      // Perspective from the point (or area light's centre) towards the
+      // casters' bounding sphere.
       const Vec3 eye = kl.position - origin;
       double radius = 0.0;
       for (std::size_t i = 0; i < nv; ++i) radius = std::max(radius, receivers[i].norm());
@@ -808,20 +917,24 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
     glClear(GL_DEPTH_BUFFER_BIT);
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(2.0f, 4.0f);  // slope-scaled depth bias against self-shadow acne
-    glUseProgram(shadowProgram);
+    const GLuint paperShadow = alphaCut ? shadowCutProgram : shadowProgram;
+    glUseProgram(paperShadow);
     const auto lightMatrix = toGl(lightViewProj);
-    glUniformMatrix4fv(glGetUniformLocation(shadowProgram, "u_lightViewProj"), 1, GL_FALSE,
+    glUniformMatrix4fv(glGetUniformLocation(paperShadow, "u_lightViewProj"), 1, GL_FALSE,
                        lightMatrix.data());
     glBindVertexArray(paperVao);
-    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(indices.size()), GL_UNSIGNED_INT, nullptr);
+    glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(vertices.size()));
+    if (!propVertices.empty()) {
+      glUseProgram(shadowProgram);
+      glUniformMatrix4fv(glGetUniformLocation(shadowProgram, "u_lightViewProj"), 1, GL_FALSE,
+                         lightMatrix.data());
+      glBindVertexArray(propVao);
+      glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(propVertices.size()));
+    }
     glDisable(GL_POLYGON_OFFSET_FILL);
   }
 
   // --- main pass ----------------------------------------------------------------
-  if (scene.paper.texture.pixels.empty())
-    uploadTexture(ruledTexture(), true);
-  else
-    uploadTexture(scene.paper.texture, false);
   glActiveTexture(GL_TEXTURE1);
   glBindTexture(GL_TEXTURE_2D, shadowTex);
   glActiveTexture(GL_TEXTURE0);
@@ -848,9 +961,12 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
 
   std::array<GLfloat, 4 * kMaxLights> lightVec{};
   std::array<GLfloat, 3 * kMaxLights> lightRad{};
+  std::array<GLfloat, 4 * kMaxLights> lightAreaNormal{};
   for (std::size_t i = 0; i < lights.size(); ++i) {
     const Light& l = lights[i];
-    // Directional: unit vector towards the light (w = 0); point: position (w = 1).
+    // Directional (and sun): unit vector towards the light (w = 0); point and
+    // area: position (w = 1). An area light is a point light at its centre
+    // whose intensity falls off with the cosine to its normal (view.hpp).
     Vec4 v;
     if (l.kind == Light::Kind::Directional)
       v << -l.direction.normalized(), 0.0;
@@ -859,17 +975,27 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
     const Vec3 rad = l.color * l.intensity;
     for (std::size_t k = 0; k < 4; ++k) lightVec[i * 4 + k] = static_cast<GLfloat>(v[k]);
     for (std::size_t k = 0; k < 3; ++k) lightRad[i * 3 + k] = static_cast<GLfloat>(rad[k]);
+    if (l.kind == Light::Kind::Area) {
+      const Vec3 n = l.direction.normalized();
+      for (std::size_t k = 0; k < 3; ++k)
+        lightAreaNormal[i * 4 + k] = static_cast<GLfloat>(n[static_cast<Eigen::Index>(k)]);
+      lightAreaNormal[i * 4 + 3] = 1.0f;
+    }
   }
   const auto numLights = static_cast<int>(lights.size());
   const int keyLight = shadows ? key : -1;
   const bool keyIsPoint =
-      shadows && lights[static_cast<std::size_t>(key)].kind == Light::Kind::Point;
+      shadows && lights[static_cast<std::size_t>(key)].kind != Light::Kind::Directional;
+  const bool albedoPass = pass == RenderPass::Albedo;
+  const bool transmit = scene.paper.transmittance > 0.0;
   const auto vp = toGl(viewProj);
   const auto lvp = toGl(lightViewProj);
 
-  auto draw = [&](bool ground) {
-    const GLuint program =
-        mainProgram(numLights, keyLight, keyIsPoint, ground, triColors && !ground);
+  // What: 0 the ground, 1 a prop (colour), 2 the paper.
+  auto draw = [&](int what, const Vec3& color, GLint first, GLsizei count) {
+    const bool plain = what != 2;
+    const GLuint program = mainProgram(numLights, keyLight, keyIsPoint, plain, triColors && !plain,
+                                       alphaCut && !plain, transmit && !plain, albedoPass);
     glUseProgram(program);
     auto loc = [&](const char* name) { return glGetUniformLocation(program, name); };
     auto set3 = [&](const char* name, const Vec3& v) {
@@ -880,14 +1006,16 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
     glUniformMatrix4fv(loc("u_lightViewProj"), 1, GL_FALSE, lvp.data());
     set3("u_frontColor", scene.paper.frontColor);
     set3("u_backColor", scene.paper.backColor);
-    set3("u_groundColor", scene.ground.color);
-    set3("u_ambient", kAmbientFromBackground * scene.background.cwiseMax(0.0));
+    set3("u_groundColor", color);
+    set3("u_ambient", (scene.environment.intensity * scene.environment.color).cwiseMax(0.0));
     set3("u_cameraPos", cam.position);
+    glUniform1f(loc("u_transmittance"), static_cast<float>(scene.paper.transmittance));
     glUniform4fv(loc("u_lightVec"), numLights, lightVec.data());
     glUniform3fv(loc("u_lightRadiance"), numLights, lightRad.data());
+    glUniform4fv(loc("u_lightAreaNormal"), numLights, lightAreaNormal.data());
     glUniform1f(loc("u_shadowTexelWorld"), static_cast<float>(shadowTexelWorld));
     glUniform1f(loc("u_shadowTexel"), 1.0f / static_cast<float>(shadowSize));
-    if (ground) {
+    if (what == 0) {
       // Pushed back a little so that paper lying exactly on it wins the depth test.
       glEnable(GL_POLYGON_OFFSET_FILL);
       glPolygonOffset(1.0f, 2.0f);
@@ -895,12 +1023,15 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
       glDrawArrays(GL_TRIANGLES, 0, 6);
       glDisable(GL_POLYGON_OFFSET_FILL);
     } else {
-      glBindVertexArray(paperVao);
-      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(indices.size()), GL_UNSIGNED_INT, nullptr);
+      glBindVertexArray(what == 1 ? propVao : paperVao);
+      glDrawArrays(GL_TRIANGLES, first, count);
     }
   };
-  if (scene.ground.enabled) draw(true);
-  if (hasPaper) draw(false);
+  if (scene.ground.enabled) draw(0, scene.ground.color, 0, 6);
+  for (std::size_t i = 0; i < scene.props.size(); ++i)
+    if (propFirst[i + 1] > propFirst[i])
+      draw(1, scene.props[i].color, propFirst[i], propFirst[i + 1] - propFirst[i]);
+  if (hasPaper) draw(2, Vec3::Zero(), 0, static_cast<GLsizei>(vertices.size()));
   glBindVertexArray(0);
   if (overlay != nullptr)
     drawOverlay(detail::buildOverlayGeometry(*overlay, sheet, cam, viewProj, origin));
@@ -956,8 +1087,8 @@ OsmesaRenderer::OsmesaRenderer(int width, int height) {
 OsmesaRenderer::~OsmesaRenderer() = default;
 
 ImageRGBA8 OsmesaRenderer::render(const RenderScene& scene, const mesh::SheetMesh& sheet,
-                                  const StructureOverlay* overlay) {
-  return impl_->render(scene, sheet, overlay);
+                                  const StructureOverlay* overlay, RenderPass pass) {
+  return impl_->render(scene, sheet, overlay, pass);
 }
 
 }  // namespace crumple::render

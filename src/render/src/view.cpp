@@ -1,6 +1,7 @@
 #include "crumple/render/view.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -135,6 +136,127 @@ std::uint8_t linearToSrgb8(double linear) {
 double srgb8ToLinear(std::uint8_t srgb) {
   const double s = srgb / 255.0;
   return s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4);
+}
+
+}  // namespace crumple::render
+
+namespace crumple::render {
+
+std::pair<Vec3, Vec3> areaLightFrame(const Light& light) {
+  const Vec3 n = light.direction.normalized();
+  const Vec3 a = n.cwiseAbs();
+  const Vec3 axis = (a.x() <= a.y() && a.x() <= a.z()) ? Vec3::UnitX()
+                    : (a.y() <= a.z())                 ? Vec3::UnitY()
+                                                       : Vec3::UnitZ();
+  const Vec3 u = (axis - axis.dot(n) * n).normalized();
+  const Vec3 v = n.cross(u);
+  return {u, v};
+}
+
+double paperTransmittance(double thickness) {
+  if (!(thickness >= 0.0) || !std::isfinite(thickness))
+    throw std::invalid_argument("paperTransmittance: thickness must be finite and >= 0");
+  constexpr double kScale = 62e-6;  // m: exp(-0.1 mm / 62 um) = 0.20
+  return std::exp(-thickness / kScale);
+}
+
+std::vector<std::array<Vec3, 3>> shadingNormals(const std::vector<Vec3>& positions,
+                                                const std::vector<std::array<int, 3>>& triangles,
+                                                double creaseAngle,
+                                                const std::vector<int>& sharpVertices) {
+  const std::size_t nt = triangles.size();
+  const std::size_t nv = positions.size();
+  std::vector<Vec3> face(nt);
+  for (std::size_t t = 0; t < nt; ++t) {
+    const auto& tri = triangles[t];
+    const Vec3 n =
+        (positions[static_cast<std::size_t>(tri[1])] - positions[static_cast<std::size_t>(tri[0])])
+            .cross(positions[static_cast<std::size_t>(tri[2])] -
+                   positions[static_cast<std::size_t>(tri[0])]);
+    const double len = n.norm();
+    face[t] = len > 0.0 ? Vec3(n / len) : Vec3::Zero();
+  }
+  // Corners of each vertex, and the triangles on each side of every edge.
+  std::vector<std::vector<std::pair<std::size_t, int>>> corners(nv);
+  for (std::size_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k)
+      corners[static_cast<std::size_t>(triangles[t][k])].push_back({t, k});
+  std::vector<bool> sharp(nv, false);
+  for (const int v : sharpVertices)
+    if (v >= 0 && static_cast<std::size_t>(v) < nv) sharp[static_cast<std::size_t>(v)] = true;
+  const double cosCrease = std::cos(creaseAngle);
+
+  std::vector<std::array<Vec3, 3>> out(nt);
+  for (std::size_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) out[t][static_cast<std::size_t>(k)] = face[t];
+
+  std::vector<int> group;  // per corner of the current vertex: its smoothing group
+  for (std::size_t v = 0; v < nv; ++v) {
+    const auto& cs = corners[v];
+    if (cs.size() < 2 || sharp[v]) continue;
+    // Two corners of v are joined when their triangles share an edge at v
+    // whose dihedral angle is below the crease angle (union-find).
+    group.assign(cs.size(), 0);
+    for (std::size_t i = 0; i < cs.size(); ++i) group[i] = static_cast<int>(i);
+    auto find = [&](int i) {
+      while (group[static_cast<std::size_t>(i)] != i) i = group[static_cast<std::size_t>(i)];
+      return i;
+    };
+    for (std::size_t i = 0; i < cs.size(); ++i)
+      for (std::size_t j = i + 1; j < cs.size(); ++j) {
+        const auto& ti = triangles[cs[i].first];
+        const auto& tj = triangles[cs[j].first];
+        int shared = 0;
+        for (const int a : ti)
+          for (const int b : tj)
+            if (a == b) ++shared;
+        if (shared != 2) continue;
+        if (face[cs[i].first].dot(face[cs[j].first]) <= cosCrease) continue;
+        const int gi = find(static_cast<int>(i)), gj = find(static_cast<int>(j));
+        if (gi != gj) group[static_cast<std::size_t>(std::max(gi, gj))] = std::min(gi, gj);
+      }
+    // Angle-weighted sums per group.
+    std::vector<Vec3> sum(cs.size(), Vec3::Zero());
+    for (std::size_t i = 0; i < cs.size(); ++i) {
+      const auto& tri = triangles[cs[i].first];
+      const int k = cs[i].second;
+      const Vec3& p = positions[v];
+      const Vec3 e1 = positions[static_cast<std::size_t>(tri[(k + 1) % 3])] - p;
+      const Vec3 e2 = positions[static_cast<std::size_t>(tri[(k + 2) % 3])] - p;
+      const double angle = std::atan2(e1.cross(e2).norm(), e1.dot(e2));
+      sum[static_cast<std::size_t>(find(static_cast<int>(i)))] += angle * face[cs[i].first];
+    }
+    for (std::size_t i = 0; i < cs.size(); ++i) {
+      const Vec3& s = sum[static_cast<std::size_t>(find(static_cast<int>(i)))];
+      const double len = s.norm();
+      if (len > 1e-12) out[cs[i].first][static_cast<std::size_t>(cs[i].second)] = s / len;
+    }
+  }
+  return out;
+}
+
+Vec4 sampleTexture(const ImageRGBA8& texture, const Vec2& uv) {
+  const int w = texture.width, h = texture.height;
+  if (w <= 0 || h <= 0) return Vec4(1.0, 1.0, 1.0, 1.0);
+  static const std::array<float, 256> kDecode = [] {
+    std::array<float, 256> t{};
+    for (int i = 0; i < 256; ++i)
+      t[static_cast<std::size_t>(i)] =
+          static_cast<float>(srgb8ToLinear(static_cast<std::uint8_t>(i)));
+    return t;
+  }();
+  const double x = uv.x() * w - 0.5, y = uv.y() * h - 0.5;
+  const double fx = std::floor(x), fy = std::floor(y);
+  const double ax = x - fx, ay = y - fy;
+  auto wrap = [](long i, int n) { return static_cast<int>(((i % n) + n) % n); };
+  const int x0 = wrap(static_cast<long>(fx), w), x1 = wrap(static_cast<long>(fx) + 1, w);
+  const int y0 = wrap(static_cast<long>(fy), h), y1 = wrap(static_cast<long>(fy) + 1, h);
+  auto texel = [&](int xi, int yi) {
+    const std::uint8_t* p = texture.at(xi, yi);
+    return Vec4(kDecode[p[0]], kDecode[p[1]], kDecode[p[2]], p[3] / 255.0);
+  };
+  return (1.0 - ay) * ((1.0 - ax) * texel(x0, y0) + ax * texel(x1, y0)) +
+         ay * ((1.0 - ax) * texel(x0, y1) + ax * texel(x1, y1));
 }
 
 }  // namespace crumple::render

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,6 +24,20 @@ struct FrameRange {
 // Parses "A-B" or "A"; throws InputError on anything else or B < A.
 FrameRange parseFrameRange(const std::string& text);
 
+// How frames are rendered (`run` and `render`).
+struct RenderSettings {
+  enum class Backend { Osmesa, Embree };
+  Backend backend = Backend::Osmesa;
+  int samplesPerPixel = 16;  // Embree
+  int maxBounces = 4;        // Embree
+  render::RenderPass pass = render::RenderPass::Beauty;
+  bool png = true;            // NNNN.png (8-bit sRGB, straight alpha)
+  bool exr = false;           // NNNN.exr (linear, premultiplied alpha)
+  bool contactSheet = false;  // contact_sheet.png beside the frames folder
+  bool movie = false;         // preview.mp4 through ffmpeg, with sound.wav when there is one
+};
+const char* backendName(RenderSettings::Backend backend);
+
 struct ShotOptions {
   std::string outDir;                 // empty: the scene's [output] dir, else out/<name>
   std::optional<FrameRange> frames;   // simulate from the scene's first frame up to last;
@@ -30,8 +45,9 @@ struct ShotOptions {
   std::optional<std::uint64_t> seed;  // overrides the scene's seed
   bool render = true;                 // `run` renders, `simulate` does not
   bool debugStructure = false;        // render the crumpling model's structure view
-  std::FILE* log = stderr;            // progress and notes
-  int interactive = -1;               // -1: detect a terminal on `log`
+  RenderSettings rendering;
+  std::FILE* log = stderr;  // progress and notes
+  int interactive = -1;     // -1: detect a terminal on `log`
 };
 
 // Milliseconds spent per stage, summed over the frames it ran for.
@@ -65,6 +81,10 @@ struct ShotReport {
   int singularVertices = 0;          // at the last frame
   int interiorSingularVertices = 0;  // at the last frame
   std::size_t maxTriangles = 0;
+  std::string renderBackend;                // "osmesa" or "embree" when frames were rendered
+  std::string contactSheetPath;             // empty unless asked for
+  std::string moviePath;                    // empty unless asked for
+  std::vector<std::string> notes;           // e.g. why there is no movie
   std::map<std::string, StageCost> stages;  // "elastic", "cache", "render"
   std::vector<std::string> warnings;
   std::string error;  // set when the run stopped early (cache valid up to the last frame)
@@ -80,12 +100,14 @@ mesh::SheetMesh buildSheet(const io::SceneSpec& scene, const io::AnimationScene*
 // NumericalError naming the frame and stage.
 ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options);
 
-// Renders frames of a cache with the OSMesa preview into framesDir
-// (NNNN.png, each written atomically). Returns the frames written.
+// Renders frames of a cache with the chosen backend into framesDir
+// (NNNN.png and/or NNNN.exr, each written atomically), then the contact sheet
+// and the movie when asked. Returns the frames written.
 struct RenderOptions {
   std::optional<FrameRange> frames;  // default: all cached frames
   std::string framesDir;             // default: <cache folder>/frames
   bool debugStructure = false;  // flat/curved regions, rulings, singular, junction, handle vertices
+  RenderSettings rendering;
   std::FILE* log = stderr;
   int interactive = -1;
 };
@@ -93,11 +115,35 @@ struct RenderReport {
   std::string framesDir;
   int framesRendered = 0;
   StageCost cost;
+  std::string contactSheetPath;    // empty unless asked for
+  std::string moviePath;           // empty unless asked for
+  std::vector<std::string> notes;  // e.g. "no soundtrack yet: the movie is silent"
 };
 RenderReport renderCache(const std::string& cachePath, const RenderOptions& options);
 
 // The render view of a scene for one cached frame.
 render::RenderScene makeRenderScene(const io::SceneSpec& scene, const cache::CameraRecord& camera);
+
+// What the renderers draw for one cached frame: the view (camera, lights,
+// environment, ground, paper look with its texture, props, this frame's sharp
+// vertices) and the sheet. Built once per scene (textures and props are
+// loaded by the constructor), then once per frame.
+struct FrameView {
+  render::RenderScene scene;
+  mesh::SheetMesh sheet;
+};
+class FrameViewBuilder {
+ public:
+  explicit FrameViewBuilder(const io::SceneSpec& scene);
+  FrameView build(const cache::FrameRecord& frame) const;
+
+ private:
+  const io::SceneSpec& scene_;
+  ImageRGBA8 texture_;
+  std::vector<render::PropMesh> boxes_;
+  std::shared_ptr<const io::AnimationScene> animation_;  // mesh props only
+  std::vector<render::PropMesh> meshPropsAtRest_;
+};
 
 // Closing summary line(s) for the terminal, and summary.json text.
 std::string summaryText(const ShotReport& report);

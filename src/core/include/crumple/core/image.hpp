@@ -1,6 +1,8 @@
 #pragma once
-// An 8-bit RGBA image, rows top to bottom, 4 bytes per pixel (straight alpha,
-// sRGB-encoded colour). Shared by the renderers and the PNG exporter.
+// Images shared by the renderers and the exporters, rows top to bottom.
+// ImageRGBA8: 4 bytes per pixel, sRGB-encoded colour, straight alpha (PNG).
+// ImageRGBAF: 4 floats per pixel, linear colour premultiplied by alpha
+// (OpenEXR's convention; the path tracer's output).
 #include <cstdint>
 #include <vector>
 
@@ -17,6 +19,20 @@ struct ImageRGBA8 {
     return pixels.data() + (static_cast<std::size_t>(y) * width + x) * 4;
   }
   const std::uint8_t* at(int x, int y) const {
+    return pixels.data() + (static_cast<std::size_t>(y) * width + x) * 4;
+  }
+};
+
+struct ImageRGBAF {
+  int width = 0;
+  int height = 0;
+  std::vector<float> pixels;  // width * height * 4
+
+  ImageRGBAF() = default;
+  ImageRGBAF(int w, int h)
+      : width(w), height(h), pixels(static_cast<std::size_t>(w) * h * 4, 0.0f) {}
+  float* at(int x, int y) { return pixels.data() + (static_cast<std::size_t>(y) * width + x) * 4; }
+  const float* at(int x, int y) const {
     return pixels.data() + (static_cast<std::size_t>(y) * width + x) * 4;
   }
 };

@@ -67,17 +67,52 @@ struct CameraSpec {
   bool fovExplicit = false;
   int width = 640;
   int height = 480;
+  // Depth of field (the path tracer only): f-number, 0 = pinhole. The focal
+  // length follows from the field of view and the sensor width:
+  // f = sensorWidth / aspect / (2 tan(yfov / 2)).
+  double fStop = 0.0;
+  double sensorWidth = 0.036;  // m
+  // m along the view axis; 0 = the distance to look_at (fixed camera) or 1 m.
+  double focusDistance = 0.0;
 };
 
 struct LightSpec {
-  enum class Kind { Directional, Point };
+  enum class Kind { Directional, Point, Area };
   std::string name;
   Kind kind = Kind::Directional;
-  Vec3 direction{-0.4, -1.0, -0.3};  // Directional: direction the light travels
-  Vec3 position = Vec3::Zero();      // Point
+  Vec3 direction{-0.4, -1.0, -0.3};  // Directional: direction the light travels; Area: its normal
+  Vec3 position = Vec3::Zero();      // Point, Area (centre)
   Vec3 color{1.0, 1.0, 1.0};
   double intensity = 1.0;
-  bool shadow = false;  // the key light casts the paper's shadow
+  double angle = 0.0;   // rad, Directional: angular diameter of the sun disc (type "sun")
+  Vec2 size{0.1, 0.1};  // m, Area: side lengths
+  bool shadow = false;  // the key light casts the paper's shadow in the preview
+};
+
+// Uniform light from the surroundings: radiance color * intensity.
+struct EnvironmentSpec {
+  Vec3 color{0.80, 0.82, 0.86};
+  double intensity = 0.25;
+};
+
+// How the paper looks (render only).
+struct PaperLookSpec {
+  std::string texture;   // resolved path of a PNG (alpha < 0.5 cuts the paper); empty = ruled
+  long textureLine = 0;  // scene file line of `texture` (for errors)
+  Vec2 textureSize = Vec2::Zero();          // m; zero = the pattern's bounding box
+  std::optional<double> transmittance;      // default: render::paperTransmittance(thickness)
+  double creaseAngle = 0.5235987755982988;  // rad: sharper edges split the shading normals
+};
+
+// A prop: an opaque diffuse mesh that is rendered (contacts come later).
+// Either a mesh node of the animation file (moving with the node), or a box.
+struct PropSpec {
+  std::string name;
+  std::string node;  // mesh node of the animation file; empty = box
+  long nodeLine = 0;
+  Vec3 boxSize{0.1, 0.1, 0.1};   // m (box)
+  Vec3 position = Vec3::Zero();  // m, centre of the box
+  Vec3 color{0.6, 0.6, 0.6};
 };
 
 struct GroundSpec {
@@ -145,7 +180,10 @@ struct SceneSpec {
   std::vector<HandleSpec> handles;
   CameraSpec camera;
   std::vector<LightSpec> lights;  // default: a key (with shadow) and a fill
+  EnvironmentSpec environment;
   GroundSpec ground;
+  PaperLookSpec look;  // [paper] texture, texture_size, transmittance, crease_deg
+  std::vector<PropSpec> props;
   OutputSpec output;
   SimSpec sim;
   ModelSpec model;

@@ -10,18 +10,26 @@
 // background (whose RGB is scene.background encoded to sRGB), in between on
 // antialiased silhouettes (4x MSAA) whose RGB is the covered samples' colour.
 //
-// Shading: Lambert, colour = albedo * (0.25 * background + sum of lights).
-// A directional light contributes color * intensity * max(0, n.l); a point
-// light color * intensity / d^2 * max(0, n.l). An empty light list means one
-// default Light{} (directional, no shadow). At most 16 lights. The key light
-// (first with shadow == true) casts the paper's shadow on the ground and on
-// the paper itself (shadow map, orthographic and fitted to the paper for a
-// directional light, perspective for a point light; PCF; slope-scaled bias).
+// Shading: two-sided Lambert with the radiometry of view.hpp: colour =
+// albedo * (environment + sum of lights), where a directional (or sun) light
+// contributes color * intensity * max(0, n.l), a point light color *
+// intensity / d^2 * max(0, n.l), an area light that of a point light at its
+// centre times the cosine to its normal. Paper with transmittance T reflects
+// (1 - T) of the light on the seen side and lets T of the light on the other
+// side through (back-lit paper glows). Shading normals: shadingNormals()
+// (split across creases and around the scene's sharp vertices). An empty
+// light list means one default Light{} (directional, no shadow). At most 16
+// lights. The key light (first with shadow == true) casts the paper's and the
+// props' shadows on everything (shadow map, orthographic and fitted to the
+// casters for a directional light, perspective for a point or area light;
+// PCF; slope-scaled bias). The environment is added unoccluded. The
+// texture's alpha cuts the paper exactly as view.hpp says (also in the
+// shadow map, so light passes through the cut).
 // Paper albedo = texture * frontColor on the front (3D winding counter-
 // clockwise as in the pattern) and texture * backColor on the back; the
 // texture's top row is at pattern y = textureSize.y, so seen from the front
 // with the pattern's +y up the image is upright and not mirrored; it repeats
-// beyond textureSize.
+// beyond textureSize. Props: flat-shaded Lambert of their colour.
 //
 // Determinism: byte-identical across runs, processes, renderer instances and
 // LP_NUM_THREADS. The first renderer of a process sets
@@ -56,8 +64,10 @@ class OsmesaRenderer {
   // (including an overlay whose triangleColors is neither empty nor one per
   // triangle, or whose sizes are not positive) and std::runtime_error on a GL
   // failure.
+  // pass = Albedo draws the albedo pass (unlit, no overlay lighting).
   ImageRGBA8 render(const RenderScene& scene, const mesh::SheetMesh& sheet,
-                    const StructureOverlay* overlay = nullptr);
+                    const StructureOverlay* overlay = nullptr,
+                    RenderPass pass = RenderPass::Beauty);
 
  private:
   struct Impl;

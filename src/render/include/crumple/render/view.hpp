@@ -1,8 +1,11 @@
 #pragma once
 // What a renderer needs to draw one frame: camera, lights, ground, the paper's
-// look. Shared by the OSMesa preview (and later the Embree path tracer).
+// look. Shared by the OSMesa preview and the Embree path tracer.
+#include <array>
 #include <cstdint>
 #include <optional>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "crumple/core/image.hpp"
@@ -18,6 +21,11 @@ struct Camera {
   double zfar = 100.0;               // m
   int width = 640;
   int height = 480;
+  // Depth of field (thin lens; the Embree path tracer only, the preview is a
+  // pinhole): lens radius in m (focal length / (2 f-number)), 0 = pinhole;
+  // points at focusDistance along the view axis are sharp.
+  double apertureRadius = 0.0;
+  double focusDistance = 1.0;  // m
 
   // A camera at `position` looking at `target`, `up` projecting upwards in the
   // image. An `up` parallel to the view direction is replaced by the world axis
@@ -26,14 +34,44 @@ struct Camera {
                        int width, int height);
 };
 
+// Radiometry shared by both renderers (so that they show the same picture):
+// a white Lambertian surface facing a light of intensity I and colour c has
+// outgoing radiance I * c (irradiance pi * I * c), for
+// - Directional: everywhere (times cos of the incidence angle). angle > 0 is
+//   a sun disc of that angular diameter (soft shadows in the path tracer; the
+//   preview treats it as a directional light);
+// - Point: at distance d, divided by d^2 (radiant intensity pi * I * c);
+// - Area: a one-sided rectangle centred on `position`, emitting towards
+//   `direction` (its normal), size.x() along `areaU` (a unit vector
+//   perpendicular to direction; see areaLightFrame) and size.y() along
+//   direction x areaU; Lambertian emitter of radiance pi * I * c / area, so
+//   far away it is a point light of intensity I * cos(angle to its normal).
+//   The preview lights with it as such a point light at its centre.
 struct Light {
-  enum class Kind { Directional, Point };
+  enum class Kind { Directional, Point, Area };
   Kind kind = Kind::Directional;
-  Vec3 direction{-0.4, -1.0, -0.3};  // Directional: direction the light travels (normalised on use)
-  Vec3 position = Vec3::Zero();      // Point
-  Vec3 color{1.0, 1.0, 1.0};         // linear RGB
+  Vec3 direction{-0.4, -1.0,
+                 -0.3};          // Directional: the direction the light travels; Area: its normal
+  Vec3 position = Vec3::Zero();  // Point, Area (centre)
+  Vec3 color{1.0, 1.0, 1.0};     // linear RGB
   double intensity = 1.0;
-  bool shadow = false;  // at most one shadow-casting light is honoured (the key)
+  double angle = 0.0;   // Directional: angular diameter of the sun disc, rad (0 = delta light)
+  Vec2 size{0.1, 0.1};  // Area: side lengths, m
+  bool shadow = false;  // the preview's shadow map: at most one light (the key) is honoured;
+                        // the path tracer shadows every light
+};
+
+// The unit vectors (u, v) spanning an area light, u x v = direction
+// (normalised): u = the world axis least aligned with direction, made
+// perpendicular to it.
+std::pair<Vec3, Vec3> areaLightFrame(const Light& light);
+
+// Light arriving from all directions not blocked by geometry: uniform
+// radiance color * intensity (a white surface open to the whole sky shows
+// exactly that). The preview adds it unoccluded (no ambient occlusion).
+struct Environment {
+  Vec3 color{0.80, 0.82, 0.86};  // linear RGB
+  double intensity = 0.25;
 };
 
 struct Ground {
@@ -43,14 +81,46 @@ struct Ground {
   Vec3 color{0.55, 0.50, 0.45};
 };
 
+// The paper's material (two-sided, diffuse): albedo a = texture * frontColor
+// on the front (3D winding counter-clockwise as in the pattern), texture *
+// backColor on the back. Of the light reaching one side, a * (1 -
+// transmittance) is reflected diffusely (BRDF a (1 - T) / pi) and a *
+// transmittance leaves the other side diffusely (BTDF a T / pi): back-lit
+// paper glows. The albedo pass shows a itself.
+//
+// The texture's alpha cuts the paper (tears, cut-outs): where the bilinear
+// alpha at full resolution (GL_LINEAR, texel centres at (i + 0.5) / width,
+// repeat wrap; sampleTexture) is below 0.5 there is no paper at all, for
+// camera rays, shadows and light alike.
 struct PaperLook {
   Vec3 frontColor{0.92, 0.92, 0.90};  // linear albedo multiplying the texture
   Vec3 backColor{0.92, 0.92, 0.90};
-  // The printed pattern texture, addressed by pattern coordinates divided by
-  // textureSize (u, v in [0, 1] over the sheet). Empty = a procedural ruled
-  // paper texture (makeRuledPaperTexture).
+  // The printed pattern texture (sRGB colour, straight alpha), addressed by
+  // pattern coordinates divided by textureSize (u, v in [0, 1] over the
+  // sheet; the texture's top row at pattern y = textureSize.y). Empty = a
+  // procedural ruled paper texture (makeRuledPaperTexture), fully opaque.
   ImageRGBA8 texture;
   Vec2 textureSize{0.21, 0.297};  // m covered by the texture in u and v
+  // Diffuse transmittance T in [0, 1) (paperTransmittance of the thickness).
+  double transmittance = 0.0;
+  // Shading normals are smooth across an edge whose dihedral angle is below
+  // creaseAngle and split across sharper ones and around the sharp vertices
+  // (the model's singular vertices): see shadingNormals.
+  double creaseAngle = 0.5235987755982988;  // rad (30 degrees)
+};
+
+// Diffuse transmittance of a sheet of the given thickness (m):
+// exp(-thickness / 62 um), 0.20 at 0.1 mm (uncoated office paper transmits
+// roughly a fifth of the light through, diffusely).
+double paperTransmittance(double thickness);
+
+// A static or animated prop (table, cup, ...), already placed in the world
+// for this frame: an opaque two-sided diffuse triangle mesh.
+struct PropMesh {
+  std::string name;
+  std::vector<Vec3> vertices;
+  std::vector<std::array<int, 3>> triangles;
+  Vec3 color{0.6, 0.6, 0.6};  // linear albedo
 };
 
 // A diagnostic overlay drawn over the sheet: the structure view of the hybrid
@@ -109,10 +179,42 @@ struct StructurePalette {
 struct RenderScene {
   Camera camera;
   std::vector<Light> lights;
+  Environment environment;
   Ground ground;
   PaperLook paper;
-  Vec3 background{0.80, 0.82, 0.86};  // linear RGB
+  std::vector<PropMesh> props;
+  // This frame's sharp vertices of the sheet (the model's singular vertices):
+  // shading normals are not smoothed around them.
+  std::vector<int> sharpVertices;
+  // The colour of uncovered pixels (their alpha is 0), linear RGB.
+  Vec3 background{0.80, 0.82, 0.86};
 };
+
+// What a render computes: the lit picture, or the albedo of the first
+// surface seen (unlit; paper texture * side colour, ground and prop colours),
+// which both renderers must agree on.
+enum class RenderPass { Beauty, Albedo };
+
+// Per-corner shading normals of the sheet (3 per triangle, unit, on the front
+// side): the angle-weighted average of the face normals around the vertex
+// over the triangles reachable without crossing an edge whose dihedral angle
+// is >= creaseAngle (or a border); the face normal itself at a sharp vertex.
+// Shared by both renderers.
+std::vector<std::array<Vec3, 3>> shadingNormals(const std::vector<Vec3>& positions,
+                                                const std::vector<std::array<int, 3>>& triangles,
+                                                double creaseAngle,
+                                                const std::vector<int>& sharpVertices);
+
+// Bilinear lookup of an sRGB8 texture as OpenGL does it with GL_LINEAR and
+// GL_REPEAT at level 0 (texel centres at (i + 0.5) / width; v = 0 is the
+// first row in memory, i.e. the image's top row): linear RGB (each texel
+// decoded before filtering, like GL_SRGB8_ALPHA8) and alpha in [0, 1].
+Vec4 sampleTexture(const ImageRGBA8& texture, const Vec2& uv);
+
+// The texture coordinates of a pattern point (the convention above).
+inline Vec2 patternToUv(const Vec2& pattern, const Vec2& textureSize) {
+  return {pattern.x() / textureSize.x(), 1.0 - pattern.y() / textureSize.y()};
+}
 
 // A deterministic ruled-notebook texture (lines and a margin) so orientation
 // and stretching are visible: off-white paper, blue horizontal rules (0.7/297

@@ -1,0 +1,234 @@
+#include "frame_output.hpp"
+
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+
+#include "crumple/core/error.hpp"
+#include "crumple/exporters/exr.hpp"
+#include "crumple/exporters/png.hpp"
+#include "crumple/render/contact_sheet.hpp"
+#include "crumple/render/embree_renderer.hpp"
+#include "crumple/render/osmesa_renderer.hpp"
+
+extern char** environ;
+
+namespace crumple::pipeline::detail {
+namespace fs = std::filesystem;
+
+std::string frameFileName(int frame, const char* extension) {
+  char name[48];
+  std::snprintf(name, sizeof name, "%04d.%s", frame, extension);
+  return name;
+}
+
+namespace {
+
+// The structure view (paper Fig. 2): flat regions green, curved regions
+// magenta with their rulings, singular vertices red, junction vertices
+// yellow, handles black.
+render::StructureOverlay structureOverlay(const cache::FrameRecord& frame) {
+  const render::StructurePalette palette;
+  render::StructureOverlay overlay;
+  for (int region : frame.regionOfTriangle) {
+    const bool curved = static_cast<std::size_t>(region) < frame.regionTypes.size() &&
+                        frame.regionTypes[static_cast<std::size_t>(region)] ==
+                            static_cast<std::uint8_t>(mesh::RegionType::Curved);
+    overlay.triangleColors.push_back(curved ? palette.curved : palette.flat);
+  }
+  const auto at = [&](int v) { return frame.positions[static_cast<std::size_t>(v)]; };
+  for (const auto& r : frame.rulings) overlay.lines.push_back({at(r[0]), at(r[1]), palette.ruling});
+  for (int v : frame.junctionVertices) overlay.points.push_back({at(v), palette.junction});
+  for (int v : frame.singularVertices) overlay.points.push_back({at(v), palette.singular});
+  for (int v : frame.handleVertices)
+    if (v >= 0) overlay.points.push_back({at(v), palette.handle});
+  return overlay;
+}
+
+// 8-bit sRGB straight alpha -> linear premultiplied float (EXR of a preview).
+ImageRGBAF toLinear(const ImageRGBA8& image) {
+  ImageRGBAF out(image.width, image.height);
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const std::uint8_t* p = image.at(x, y);
+      float* q = out.at(x, y);
+      const float a = static_cast<float>(p[3]) / 255.0f;
+      for (int k = 0; k < 3; ++k) q[k] = static_cast<float>(render::srgb8ToLinear(p[k])) * a;
+      q[3] = a;
+    }
+  return out;
+}
+
+}  // namespace
+
+struct FrameRenderer::Impl {
+  const io::SceneSpec& scene;
+  std::string framesDir;
+  bool debugStructure = false;
+  RenderSettings settings;
+  std::uint64_t seed = 0;
+  FrameViewBuilder views;
+  std::unique_ptr<render::OsmesaRenderer> osmesa;
+  std::unique_ptr<render::EmbreeRenderer> embree;
+
+  Impl(const io::SceneSpec& s, std::string dir, bool debug, const RenderSettings& r,
+       std::uint64_t sd)
+      : scene(s),
+        framesDir(std::move(dir)),
+        debugStructure(debug),
+        settings(r),
+        seed(sd),
+        views(s) {
+    if (settings.backend == RenderSettings::Backend::Embree) {
+      if (debugStructure)
+        throw InputError("--debug-structure",
+                         "the structure view is drawn by the osmesa backend only");
+      embree = std::make_unique<render::EmbreeRenderer>();
+    } else {
+      osmesa = std::make_unique<render::OsmesaRenderer>(scene.camera.width, scene.camera.height);
+    }
+  }
+
+  void render(const cache::FrameRecord& frame) {
+    const FrameView fv = views.build(frame);
+    const fs::path dir(framesDir);
+    if (embree) {
+      render::PathTraceSettings pt;
+      pt.samplesPerPixel = settings.samplesPerPixel;
+      pt.maxBounces = settings.maxBounces;
+      pt.seed = seed;
+      pt.frame = frame.frame;
+      pt.pass = settings.pass;
+      const ImageRGBAF image = embree->render(fv.scene, fv.sheet, pt);
+      if (settings.exr)
+        exporters::writeExr((dir / frameFileName(frame.frame, "exr")).string(), image);
+      if (settings.png)
+        exporters::writePng((dir / frameFileName(frame.frame)).string(),
+                            render::toSrgb8(image, fv.scene.background));
+      return;
+    }
+    ImageRGBA8 image;
+    if (debugStructure) {
+      const render::StructureOverlay overlay = structureOverlay(frame);
+      image = osmesa->render(fv.scene, fv.sheet, &overlay, settings.pass);
+    } else {
+      image = osmesa->render(fv.scene, fv.sheet, nullptr, settings.pass);
+    }
+    if (settings.exr)
+      exporters::writeExr((dir / frameFileName(frame.frame, "exr")).string(), toLinear(image));
+    if (settings.png) exporters::writePng((dir / frameFileName(frame.frame)).string(), image);
+  }
+};
+
+FrameRenderer::FrameRenderer(const io::SceneSpec& scene, std::string framesDir, bool debugStructure,
+                             const RenderSettings& settings, std::uint64_t seed)
+    : impl_(std::make_unique<Impl>(scene, std::move(framesDir), debugStructure, settings, seed)) {}
+FrameRenderer::~FrameRenderer() = default;
+void FrameRenderer::render(const cache::FrameRecord& frame) { impl_->render(frame); }
+
+std::vector<int> writeContactSheet(const std::string& framesDir, int first, int last,
+                                   const std::string& path) {
+  constexpr int kMaxCells = 36;
+  const int n = last - first + 1;
+  std::vector<int> picked;
+  if (n <= kMaxCells) {
+    for (int f = first; f <= last; ++f) picked.push_back(f);
+  } else {
+    for (int i = 0; i < kMaxCells; ++i)
+      picked.push_back(first + static_cast<int>(std::lround(static_cast<double>(i) * (n - 1) /
+                                                            (kMaxCells - 1))));
+  }
+  std::vector<std::pair<int, ImageRGBA8>> frames;
+  for (const int f : picked)
+    frames.emplace_back(f, exporters::readPng((fs::path(framesDir) / frameFileName(f)).string()));
+  const int cellWidth = std::min(320, frames.front().second.width);
+  exporters::writePng(path, render::makeContactSheet(frames, 0, cellWidth));
+  return picked;
+}
+
+namespace {
+
+// The first executable `name` on PATH, or empty.
+std::string findOnPath(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  if (!path) return {};
+  std::stringstream dirs(path);
+  std::string dir;
+  while (std::getline(dirs, dir, ':')) {
+    if (dir.empty()) continue;
+    const fs::path candidate = fs::path(dir) / name;
+    if (::access(candidate.c_str(), X_OK) == 0) return candidate.string();
+  }
+  return {};
+}
+
+// Runs argv[0] with its arguments (no shell) and returns its exit status, or
+// -1 when it could not be started.
+int runProcess(const std::vector<std::string>& argv) {
+  std::vector<char*> args;
+  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  pid_t pid = 0;
+  if (::posix_spawn(&pid, argv[0].c_str(), nullptr, nullptr, args.data(), environ) != 0) return -1;
+  int status = 0;
+  if (::waitpid(pid, &status, 0) < 0) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace
+
+bool makeMovie(const std::string& framesDir, int first, int last, double fps,
+               const std::string& sound, const std::string& path, std::string& note) {
+  const std::string ffmpeg = findOnPath("ffmpeg");
+  if (ffmpeg.empty()) {
+    note =
+        "--movie: ffmpeg is not installed (Debian: apt-get install ffmpeg); the frames are "
+        "written, no movie";
+    return false;
+  }
+  char rate[32];
+  std::snprintf(rate, sizeof rate, "%.6g", fps);
+  const std::string tmp = path + ".tmp.mp4";
+  std::vector<std::string> argv = {ffmpeg,
+                                   "-nostdin",
+                                   "-loglevel",
+                                   "error",
+                                   "-y",
+                                   "-framerate",
+                                   rate,
+                                   "-start_number",
+                                   std::to_string(first),
+                                   "-i",
+                                   (fs::path(framesDir) / "%04d.png").string()};
+  std::error_code ec;
+  const bool withSound = fs::is_regular_file(sound, ec);
+  if (withSound) argv.insert(argv.end(), {"-i", sound});
+  argv.insert(argv.end(), {"-frames:v", std::to_string(last - first + 1)});
+  if (withSound) argv.insert(argv.end(), {"-c:a", "aac", "-b:a", "192k", "-shortest"});
+  // Even dimensions for yuv420p; transparent pixels over black.
+  argv.insert(argv.end(), {"-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264", "-pix_fmt",
+                           "yuv420p", "-crf", "18", "-movflags", "+faststart", tmp});
+  const int status = runProcess(argv);
+  if (status != 0) {
+    fs::remove(tmp, ec);
+    note = "--movie: ffmpeg failed (exit status " + std::to_string(status) + "); no movie written";
+    return false;
+  }
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    note = "--movie: cannot write " + path;
+    return false;
+  }
+  note =
+      withSound ? "" : "--movie: no soundtrack in this shot yet (sound.wav); the movie is silent";
+  return true;
+}
+
+}  // namespace crumple::pipeline::detail
