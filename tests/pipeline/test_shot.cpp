@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <vector>
 
 #include "crumple/core/error.hpp"
 #include "crumple/core/parallel.hpp"
@@ -390,4 +392,125 @@ TEST(HandleRig, SaysHowFarAHandleIsFromItsVertex) {
   const pipeline::HandleRig exact(good, &goodAnim, pipeline::buildSheet(good, &goodAnim),
                                   good.frameTime(good.frameStart));
   EXPECT_EQ(count(exact.bindWarnings(), "pattern point"), 0);
+}
+
+namespace {
+
+// Base64 of raw bytes (a glTF data URI).
+std::string base64(const std::vector<std::uint8_t>& bytes) {
+  static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    const std::uint32_t b0 = bytes[i];
+    const std::uint32_t b1 = i + 1 < bytes.size() ? bytes[i + 1] : 0;
+    const std::uint32_t b2 = i + 2 < bytes.size() ? bytes[i + 2] : 0;
+    const std::uint32_t v = (b0 << 16) | (b1 << 8) | b2;
+    out += kAlphabet[(v >> 18) & 63];
+    out += kAlphabet[(v >> 12) & 63];
+    out += i + 1 < bytes.size() ? kAlphabet[(v >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? kAlphabet[v & 63] : '=';
+  }
+  return out;
+}
+
+// A glTF with one mesh node "Cup" (a triangle) whose translation moves from
+// (0, 0, 0) at t = 0 to (1, 0, 0) at t = 1 s.
+std::string movingPropGltf() {
+  std::vector<std::uint8_t> buf;
+  auto putF = [&](float f) {
+    std::uint8_t b[4];
+    std::memcpy(b, &f, 4);
+    buf.insert(buf.end(), b, b + 4);
+  };
+  for (const float f : {0.f, 0.f, 0.f, 0.1f, 0.f, 0.f, 0.f, 0.1f, 0.f}) putF(f);  // 36 bytes
+  for (const std::uint16_t i : {std::uint16_t{0}, std::uint16_t{1}, std::uint16_t{2},
+                                std::uint16_t{0}}) {  // 8 bytes (padded)
+    buf.push_back(static_cast<std::uint8_t>(i & 0xff));
+    buf.push_back(static_cast<std::uint8_t>(i >> 8));
+  }
+  for (const float f : {0.f, 1.f}) putF(f);                      // times: 8 bytes at 44
+  for (const float f : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f}) putF(f);  // translations: 24 bytes at 52
+  return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+  "nodes": [{"name": "Cup", "mesh": 0}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+  "buffers": [{"byteLength": )" +
+         std::to_string(buf.size()) + R"(, "uri": "data:application/octet-stream;base64,)" +
+         base64(buf) + R"("}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
+                  {"buffer": 0, "byteOffset": 36, "byteLength": 6},
+                  {"buffer": 0, "byteOffset": 44, "byteLength": 8},
+                  {"buffer": 0, "byteOffset": 52, "byteLength": 24}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                 "min": [0, 0, 0], "max": [0.1, 0.1, 0]},
+                {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"},
+                {"bufferView": 2, "componentType": 5126, "count": 2, "type": "SCALAR",
+                 "min": [0], "max": [1]},
+                {"bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3"}],
+  "animations": [{"channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
+                  "samplers": [{"input": 2, "output": 3, "interpolation": "LINEAR"}]}]})";
+}
+
+}  // namespace
+
+TEST(FrameView, PropsBoxesAndAnimatedMeshNodesMaterialAndSharpVertices) {
+  TempDir tmp;
+  writeFile(tmp / "props.gltf", movingPropGltf());
+  const auto scene = io::parseScene(R"([scene]
+animation = "props.gltf"
+[sheet]
+width = 0.2
+height = 0.3
+[paper]
+transmittance = 0.4
+crease_deg = 20
+[[props]]
+node = "Cup"
+color = [0.9, 0.1, 0.1]
+[[props]]
+name = "table"
+shape = "box"
+size = [1.0, 0.1, 1.0]
+position = [0.0, -0.05, 0.0]
+[[lights]]
+type = "area"
+position = [0, 1, 0]
+direction = [0, -1, 0]
+size = [0.5, 0.25]
+)",
+                                    "props.toml", tmp.path().string());
+  cache::FrameRecord frame;
+  frame.pattern = {{0, 0}, {0.2, 0}, {0, 0.3}};
+  frame.positions = {{0, 0, 0}, {0.2, 0, 0}, {0, 0, -0.3}};
+  frame.triangles = {{0, 1, 2}};
+  frame.singularVertices = {1};
+  frame.camera.position = Vec3(0, 1, 1);
+  frame.camera.yfov = 0.7;
+  const pipeline::FrameViewBuilder views(scene);
+  for (const double t : {0.0, 0.5}) {
+    frame.time = t;
+    const auto fv = views.build(frame);
+    ASSERT_EQ(fv.scene.props.size(), 2u);
+    const auto& box = fv.scene.props[0];  // boxes first, then mesh props
+    EXPECT_EQ(box.name, "table");
+    EXPECT_EQ(box.triangles.size(), 12u);
+    EXPECT_NEAR(box.vertices[0].y(), -0.1, 1e-12);
+    const auto& cup = fv.scene.props[1];
+    EXPECT_EQ(cup.name, "Cup");
+    ASSERT_EQ(cup.vertices.size(), 3u);
+    EXPECT_NEAR(cup.vertices[0].x(), t, 1e-6) << "the mesh moves with its node";
+    EXPECT_NEAR(cup.vertices[1].x(), t + 0.1, 1e-6);
+    EXPECT_TRUE(cup.color.isApprox(Vec3(0.9, 0.1, 0.1)));
+    EXPECT_DOUBLE_EQ(fv.scene.paper.transmittance, 0.4);
+    EXPECT_NEAR(fv.scene.paper.creaseAngle, 20.0 * 3.14159265358979 / 180.0, 1e-9);
+    EXPECT_EQ(fv.scene.sharpVertices, std::vector<int>{1});
+    ASSERT_EQ(fv.scene.lights.size(), 1u);
+    EXPECT_EQ(fv.scene.lights[0].kind, render::Light::Kind::Area);
+    EXPECT_TRUE(fv.scene.lights[0].size.isApprox(Vec2(0.5, 0.25)));
+    EXPECT_TRUE(fv.scene.paper.textureSize.isApprox(Vec2(0.2, 0.3)));
+  }
+  // The default transmittance follows the preset's thickness (90 um: 0.23).
+  const auto plain = io::parseScene("[sheet]\nwidth = 0.2\nheight = 0.3\n", "p.toml", ".");
+  const auto fv = pipeline::FrameViewBuilder(plain).build(frame);
+  EXPECT_NEAR(fv.scene.paper.transmittance, std::exp(-90e-6 / 62e-6), 1e-12);
+  EXPECT_EQ(fv.scene.camera.apertureRadius, 0.0) << "pinhole without f_stop";
 }
