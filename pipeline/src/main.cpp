@@ -85,11 +85,12 @@ void addRenderOptions(CLI::App* cmd, Args& a) {
   cmd->add_flag("--exr", a.exr, "also write NNNN.exr (linear, premultiplied alpha, half floats)");
   cmd->add_flag("--no-png", a.noPng, "do not write NNNN.png (with --exr)");
   cmd->add_flag("--contact-sheet", a.contactSheet,
-                "write contact_sheet.png beside the frames folder: a grid of up to 36 of the "
-                "rendered frames, evenly spaced, labelled with their numbers");
+                "write contact_sheet.png into the shot's folder (beside the cache): a grid of up "
+                "to 36 of the rendered frames, evenly spaced, labelled with their numbers");
   cmd->add_flag("--movie", a.movie,
-                "write preview.mp4 beside the frames folder with ffmpeg (H.264), with sound.wav "
-                "muxed in when the shot has one; says so when ffmpeg is not installed");
+                "write preview.mp4 into the shot's folder (beside the cache) with ffmpeg (H.264), "
+                "with the shot's sound.wav muxed in when there is one; says so when ffmpeg is not "
+                "installed");
 }
 
 int runOrSimulate(const Args& a, bool render) {

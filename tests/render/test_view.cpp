@@ -114,3 +114,65 @@ TEST(RuledPaperTexture, DeterministicWithRulesAndMargin) {
 
 }  // namespace
 }  // namespace crumple::render
+
+namespace crumple::render {
+namespace {
+
+// Two triangles sharing the edge (0, 1) along X, the second one folded up by
+// `fold` radians about it.
+std::vector<Vec3> foldedPair(double fold) {
+  return {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.5, 0, -1),
+          Vec3(0.5, std::sin(fold), std::cos(fold))};
+}
+const std::vector<std::array<int, 3>> kPair = {{0, 1, 2}, {1, 0, 3}};
+
+TEST(ShadingNormals, SmoothBelowTheCreaseAngleSplitAboveIt) {
+  // A 20 degree fold: below the 30 degree crease angle, the shared corners get
+  // one normal halfway between the faces.
+  const auto smooth = shadingNormals(foldedPair(0.349), kPair, 0.5236, {});
+  EXPECT_TRUE(smooth[0][0].isApprox(smooth[1][1], 1e-12)) << "vertex 0 shared";
+  EXPECT_TRUE(smooth[0][1].isApprox(smooth[1][0], 1e-12)) << "vertex 1 shared";
+  EXPECT_NEAR(smooth[0][0].norm(), 1.0, 1e-12);
+  const Vec3 face0(0, 1, 0);
+  EXPECT_NEAR(std::acos(smooth[0][0].dot(face0)), 0.5 * 0.349, 1e-6);
+  // The unshared corners keep their face normal.
+  EXPECT_TRUE(smooth[0][2].isApprox(face0, 1e-12));
+  // A 40 degree fold is a crease: every corner keeps its face normal.
+  const auto sharp = shadingNormals(foldedPair(0.698), kPair, 0.5236, {});
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_TRUE(sharp[0][static_cast<std::size_t>(k)].isApprox(face0, 1e-12));
+    EXPECT_NEAR(std::acos(sharp[1][static_cast<std::size_t>(k)].dot(face0)), 0.698, 1e-6);
+  }
+}
+
+TEST(ShadingNormals, NoSmoothingAroundASharpVertex) {
+  const auto n = shadingNormals(foldedPair(0.349), kPair, 0.5236, {0});
+  EXPECT_TRUE(n[0][0].isApprox(Vec3(0, 1, 0), 1e-12)) << "vertex 0 is sharp";
+  EXPECT_FALSE(n[1][1].isApprox(n[0][0], 1e-6));
+  EXPECT_TRUE(n[0][1].isApprox(n[1][0], 1e-12)) << "vertex 1 is still smooth";
+}
+
+TEST(SampleTexture, BilinearLikeGlWithRepeatAndSrgbDecodedTexels) {
+  ImageRGBA8 t(2, 1);
+  const std::uint8_t px[8] = {0, 0, 0, 0, 255, 255, 255, 255};
+  std::copy(px, px + 8, t.pixels.begin());
+  // Texel centres at u = 0.25 and 0.75.
+  EXPECT_NEAR(sampleTexture(t, Vec2(0.25, 0.5)).x(), 0.0, 1e-12);
+  EXPECT_NEAR(sampleTexture(t, Vec2(0.75, 0.5)).x(), 1.0, 1e-12);
+  const Vec4 mid = sampleTexture(t, Vec2(0.5, 0.5));
+  EXPECT_NEAR(mid.x(), 0.5, 1e-6) << "filtered in linear light";
+  EXPECT_NEAR(mid.w(), 0.5, 1e-6);
+  // Repeat: u = 0 lies halfway between the last texel and the first.
+  EXPECT_NEAR(sampleTexture(t, Vec2(0.0, 0.5)).w(), 0.5, 1e-6);
+  EXPECT_NEAR(sampleTexture(t, Vec2(1.25, 0.5)).w(), 0.0, 1e-6);
+}
+
+TEST(PaperTransmittance, FallsWithThickness) {
+  EXPECT_NEAR(paperTransmittance(1e-4), std::exp(-1e-4 / 62e-6), 1e-15);
+  EXPECT_GT(paperTransmittance(7e-5), paperTransmittance(1.1e-4));
+  EXPECT_DOUBLE_EQ(paperTransmittance(0.0), 1.0);
+  EXPECT_THROW(paperTransmittance(-1.0), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace crumple::render

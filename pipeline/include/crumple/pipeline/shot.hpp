@@ -33,8 +33,8 @@ struct RenderSettings {
   render::RenderPass pass = render::RenderPass::Beauty;
   bool png = true;            // NNNN.png (8-bit sRGB, straight alpha)
   bool exr = false;           // NNNN.exr (linear, premultiplied alpha)
-  bool contactSheet = false;  // contact_sheet.png beside the frames folder
-  bool movie = false;         // preview.mp4 through ffmpeg, with sound.wav when there is one
+  bool contactSheet = false;  // contact_sheet.png in the shot's folder (beside the cache)
+  bool movie = false;         // preview.mp4 there through ffmpeg, with its sound.wav if any
 };
 const char* backendName(RenderSettings::Backend backend);
 
