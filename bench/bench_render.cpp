@@ -286,20 +286,6 @@ ImageRGBAF readRgbaf(const fs::path& path) {
   return image;
 }
 
-// The paper texture, decoded texel by texel as sampleTexture does (sRGB ->
-// linear colour, straight alpha / 255), for Blender's float image.
-ImageRGBAF linearTexture(const ImageRGBA8& tex) {
-  ImageRGBAF out(tex.width, tex.height);
-  for (int y = 0; y < tex.height; ++y)
-    for (int x = 0; x < tex.width; ++x) {
-      const std::uint8_t* s = tex.at(x, y);
-      float* d = out.at(x, y);
-      for (int k = 0; k < 3; ++k) d[k] = static_cast<float>(render::srgb8ToLinear(s[k]));
-      d[3] = static_cast<float>(s[3]) / 255.0f;
-    }
-  return out;
-}
-
 void writeSceneJson(const fs::path& path, const render::RenderScene& s, bool hasGround,
                     int maxBounces, std::uint64_t seed) {
   auto f = openOut(path);
@@ -534,7 +520,7 @@ int run(const Options& o) {
   for (std::size_t i = 0; i < rs.props.size(); ++i)
     writePropObj(dir / ("prop" + std::to_string(i) + ".obj"), rs.props[i]);
   exporters::writePng((dir / "paper.png").string(), rs.paper.texture);
-  writeRgbaf(dir / "paper.rgbaf", linearTexture(rs.paper.texture));
+  writeRgbaf(dir / "paper.rgbaf", render::decodeSrgb8(rs.paper.texture, /*premultiply=*/false));
   writeSceneJson(dir / "scene.json", rs, ground, o.maxBounces, o.seed);
 
   setThreadCount(o.threads);

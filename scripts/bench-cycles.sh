@@ -33,19 +33,12 @@ runs="${RUNS:-3}"
 resolution="${RESOLUTION:-640x480}"
 blender="${BLENDER:-blender}"
 
-# Build dependencies, then Blender (quietly, with sudo when not root).
-bash "$root/scripts/bootstrap.sh"
-if ! command -v "$blender" >/dev/null 2>&1; then
-  SUDO=""
-  if [ "$(id -u)" -ne 0 ]; then
-    if command -v sudo >/dev/null 2>&1; then SUDO="sudo"; else
-      echo "bench-cycles: need root (or sudo) to install blender" >&2
-      exit 1
-    fi
-  fi
-  echo "bench-cycles: installing the Debian package blender" >&2
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends blender >/dev/null
+# Build dependencies, and Blender (the Debian package) when no binary is given
+# or found.
+if command -v "$blender" >/dev/null 2>&1; then
+  bash "$root/scripts/bootstrap.sh"
+else
+  bash "$root/scripts/bootstrap.sh" blender
   blender=blender
 fi
 "$blender" --version 2>/dev/null | head -1 >&2

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages crumple builds with (idempotent; silent when
 # everything is already there). See ../shared/DEPENDENCIES.md for why each.
+# Extra package names given as arguments are installed too (e.g. blender for
+# scripts/bench-cycles.sh).
 set -euo pipefail
 
 PACKAGES=(
@@ -10,6 +12,7 @@ PACKAGES=(
   libtomlplusplus-dev libcli11-dev
   libcgal-dev libgmp-dev libmpfr-dev
   libgtest-dev libbenchmark-dev
+  "$@"
 )
 
 missing=()

@@ -51,20 +51,6 @@ render::StructureOverlay structureOverlay(const cache::FrameRecord& frame) {
   return overlay;
 }
 
-// 8-bit sRGB straight alpha -> linear premultiplied float (EXR of a preview).
-ImageRGBAF toLinear(const ImageRGBA8& image) {
-  ImageRGBAF out(image.width, image.height);
-  for (int y = 0; y < image.height; ++y)
-    for (int x = 0; x < image.width; ++x) {
-      const std::uint8_t* p = image.at(x, y);
-      float* q = out.at(x, y);
-      const float a = static_cast<float>(p[3]) / 255.0f;
-      for (int k = 0; k < 3; ++k) q[k] = static_cast<float>(render::srgb8ToLinear(p[k])) * a;
-      q[3] = a;
-    }
-  return out;
-}
-
 }  // namespace
 
 struct FrameRenderer::Impl {
@@ -121,7 +107,8 @@ struct FrameRenderer::Impl {
       image = osmesa->render(fv.scene, fv.sheet, nullptr, settings.pass);
     }
     if (settings.exr)
-      exporters::writeExr((dir / frameFileName(frame.frame, "exr")).string(), toLinear(image));
+      exporters::writeExr((dir / frameFileName(frame.frame, "exr")).string(),
+                          render::decodeSrgb8(image, /*premultiply=*/true));
     if (settings.png) exporters::writePng((dir / frameFileName(frame.frame)).string(), image);
   }
 };

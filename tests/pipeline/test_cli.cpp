@@ -4,6 +4,9 @@
 
 #include <limits>
 
+#include "crumple/exporters/exr.hpp"
+#include "crumple/exporters/png.hpp"
+#include "crumple/render/view.hpp"
 #include "test_util.hpp"
 
 using namespace crumple::testing;
@@ -145,6 +148,25 @@ TEST(Cli, RenderWithEmbreeWritesPngAndExrIdenticallyOnAnyThreadCount) {
     EXPECT_EQ(one, readFile(tmp / "e2" / f)) << f << " differs between 1 and 2 threads";
   }
   EXPECT_FALSE(fs::exists(tmp / "e1/0001.png")) << "only the asked frames";
+  // The preview's EXR is its PNG in linear light, premultiplied; --no-png
+  // writes the EXR alone.
+  ASSERT_EQ(
+      runCrumple("render " + cache + " --frames 2-2 --exr --out " + (tmp / "o").string()).status,
+      0);
+  ASSERT_EQ(
+      runCrumple("render " + cache + " --frames 2-2 --exr --no-png --out " + (tmp / "x").string())
+          .status,
+      0);
+  EXPECT_FALSE(fs::exists(tmp / "x/0002.png"));
+  EXPECT_EQ(readFile(tmp / "x/0002.exr"), readFile(tmp / "o/0002.exr"));
+  const auto png = crumple::exporters::readPng((tmp / "o/0002.png").string());
+  const auto exr = crumple::exporters::readExr((tmp / "o/0002.exr").string());
+  ASSERT_EQ(exr.width, png.width);
+  for (const auto& [x, y] : {std::pair{0, 0}, std::pair{png.width / 2, png.height / 2}}) {
+    const float a = png.at(x, y)[3] / 255.0f;
+    EXPECT_NEAR(exr.at(x, y)[3], a, 1e-3);
+    EXPECT_NEAR(exr.at(x, y)[1], crumple::render::srgb8ToLinear(png.at(x, y)[1]) * a, 2e-3);
+  }
   EXPECT_FALSE(fs::exists(tmp / "e1/0002.png.tmp")) << "no temporary left behind";
   // Options that make no sense are refused with exit 2.
   EXPECT_EQ(runCrumple("render " + cache + " --backend embree --spp 0").status, 2);

@@ -138,6 +138,20 @@ double srgb8ToLinear(std::uint8_t srgb) {
   return s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4);
 }
 
+ImageRGBAF decodeSrgb8(const ImageRGBA8& image, bool premultiply) {
+  ImageRGBAF out(image.width, image.height);
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const std::uint8_t* p = image.at(x, y);
+      float* q = out.at(x, y);
+      const float a = static_cast<float>(p[3]) / 255.0f;
+      const float scale = premultiply ? a : 1.0f;
+      for (int k = 0; k < 3; ++k) q[k] = static_cast<float>(srgb8ToLinear(p[k])) * scale;
+      q[3] = a;
+    }
+  return out;
+}
+
 }  // namespace crumple::render
 
 namespace crumple::render {

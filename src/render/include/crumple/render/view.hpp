@@ -241,5 +241,8 @@ std::optional<Vec2> projectToPixel(const Camera& camera, const Vec3& world);
 std::uint8_t linearToSrgb8(double linear);
 // 8-bit sRGB -> linear [0, 1].
 double srgb8ToLinear(std::uint8_t srgb);
+// An 8-bit sRGB image (straight alpha) as linear floats, colour premultiplied
+// by alpha when `premultiply` (OpenEXR's convention) or left straight.
+ImageRGBAF decodeSrgb8(const ImageRGBA8& image, bool premultiply);
 
 }  // namespace crumple::render
