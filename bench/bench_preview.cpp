@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
       scene.camera.width = width;
       scene.camera.height = height;
       const auto frame = reader.readFrame(reader.frameCount() - 1);
-      const pipeline::FrameViewBuilder views(scene);
+      const pipeline::FrameViewBuilder views(scene, header.extensions);
       const auto fv = views.build(frame);
       (void)renderer.render(fv.scene, fv.sheet);  // warm-up: shader compilation
       std::vector<double> ms, msPng;

@@ -500,7 +500,7 @@ int run(const Options& o) {
   if (index == reader.frameCount())
     throw InputError(o.cache, "no frame " + std::to_string(o.frame) + " in the cache");
   const cache::FrameRecord record = reader.readFrame(index);
-  const pipeline::FrameViewBuilder builder(scene);
+  const pipeline::FrameViewBuilder builder(scene, header.extensions);
   pipeline::FrameView fv = builder.build(record);
   if (o.width > 0) {
     fv.scene.camera.width = o.width;

@@ -162,11 +162,10 @@ void writePng(const std::string& path, const ImageRGBA8& image) {
   }
 }
 
-ImageRGBA8 readPng(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory, not a PNG");
-  FilePtr file(std::fopen(path.c_str(), "rb"));
-  if (!file) throw InputError(path, std::string("cannot open PNG: ") + std::strerror(errno));
+namespace {
+
+// Decodes a PNG from an open stream; `path` names it in errors.
+ImageRGBA8 decodePng(const FilePtr& file, const std::string& path) {
   png_byte signature[8] = {};
   if (std::fread(signature, 1, sizeof signature, file.get()) != sizeof signature ||
       png_sig_cmp(signature, 0, sizeof signature) != 0)
@@ -192,6 +191,24 @@ ImageRGBA8 readPng(const std::string& path) {
   for (png_uint_32 y = 0; y < height; ++y) rows[y] = image.at(0, static_cast<int>(y));
   if (!decodeRows(s.png, rows.data())) throw InputError(path, "malformed PNG: " + describe(state));
   return image;
+}
+
+}  // namespace
+
+ImageRGBA8 readPng(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory, not a PNG");
+  FilePtr file(std::fopen(path.c_str(), "rb"));
+  if (!file) throw InputError(path, std::string("cannot open PNG: ") + std::strerror(errno));
+  return decodePng(file, path);
+}
+
+ImageRGBA8 decodePngBytes(const std::vector<std::uint8_t>& bytes, const std::string& name) {
+  if (bytes.empty()) throw InputError(name, "not a PNG file (empty)");
+  // fmemopen reads the buffer in place (mode "rb" does not write to it).
+  FilePtr file(::fmemopen(const_cast<std::uint8_t*>(bytes.data()), bytes.size(), "rb"));
+  if (!file) throw InputError(name, std::string("cannot read PNG: ") + std::strerror(errno));
+  return decodePng(file, name);
 }
 
 }  // namespace crumple::exporters

@@ -63,14 +63,14 @@ struct FrameRenderer::Impl {
   std::unique_ptr<render::OsmesaRenderer> osmesa;
   std::unique_ptr<render::EmbreeRenderer> embree;
 
-  Impl(const io::SceneSpec& s, std::string dir, bool debug, const RenderSettings& r,
-       std::uint64_t sd)
+  Impl(const io::SceneSpec& s, const std::vector<cache::ExtensionBlock>& headerBlocks,
+       std::string dir, bool debug, const RenderSettings& r, std::uint64_t sd)
       : scene(s),
         framesDir(std::move(dir)),
         debugStructure(debug),
         settings(r),
         seed(sd),
-        views(s) {
+        views(s, headerBlocks) {
     if (settings.backend == RenderSettings::Backend::Embree) {
       if (debugStructure)
         throw InputError("--debug-structure",
@@ -113,9 +113,12 @@ struct FrameRenderer::Impl {
   }
 };
 
-FrameRenderer::FrameRenderer(const io::SceneSpec& scene, std::string framesDir, bool debugStructure,
+FrameRenderer::FrameRenderer(const io::SceneSpec& scene,
+                             const std::vector<cache::ExtensionBlock>& headerBlocks,
+                             std::string framesDir, bool debugStructure,
                              const RenderSettings& settings, std::uint64_t seed)
-    : impl_(std::make_unique<Impl>(scene, std::move(framesDir), debugStructure, settings, seed)) {}
+    : impl_(std::make_unique<Impl>(scene, headerBlocks, std::move(framesDir), debugStructure,
+                                   settings, seed)) {}
 FrameRenderer::~FrameRenderer() = default;
 void FrameRenderer::render(const cache::FrameRecord& frame) { impl_->render(frame); }
 

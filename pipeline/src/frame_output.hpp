@@ -18,11 +18,13 @@ namespace crumple::pipeline::detail {
 std::string frameFileName(int frame, const char* extension = "png");
 
 // Renders cached frames with one renderer reused across frames and writes
-// framesDir/NNNN.png and/or NNNN.exr (each atomically).
+// framesDir/NNNN.png and/or NNNN.exr (each atomically). headerBlocks: the
+// cache header's extension blocks (FrameViewBuilder).
 class FrameRenderer {
  public:
-  FrameRenderer(const io::SceneSpec& scene, std::string framesDir, bool debugStructure,
-                const RenderSettings& settings, std::uint64_t seed);
+  FrameRenderer(const io::SceneSpec& scene, const std::vector<cache::ExtensionBlock>& headerBlocks,
+                std::string framesDir, bool debugStructure, const RenderSettings& settings,
+                std::uint64_t seed);
   ~FrameRenderer();
   FrameRenderer(const FrameRenderer&) = delete;
   FrameRenderer& operator=(const FrameRenderer&) = delete;

@@ -83,16 +83,6 @@ cache::CameraRecord cameraAt(const io::SceneSpec& scene, const io::AnimationScen
   return rec;
 }
 
-mesh::SheetMesh sheetOfFrame(const cache::FrameRecord& frame) {
-  mesh::SheetMesh m;
-  m.pattern = frame.pattern;
-  m.positions = frame.positions;
-  m.triangles = frame.triangles;
-  m.regionOfTriangle = frame.regionOfTriangle;
-  for (auto t : frame.regionTypes) m.regionTypes.push_back(static_cast<mesh::RegionType>(t));
-  return m;
-}
-
 // After the frames: the contact sheet (DIR/contact_sheet.png) and the movie
 // (DIR/preview.mp4, with DIR/sound.wav when there is one), DIR being the
 // shot's folder.
@@ -260,147 +250,6 @@ mesh::SheetMesh buildSheet(const io::SceneSpec& scene, const io::AnimationScene*
   return sheet;
 }
 
-render::RenderScene makeRenderScene(const io::SceneSpec& scene, const cache::CameraRecord& camera) {
-  render::RenderScene view;
-  view.camera.position = camera.position;
-  view.camera.rotation = camera.rotation;
-  view.camera.yfov = camera.yfov > 0.0 ? camera.yfov : scene.camera.yfov;
-  view.camera.width = scene.camera.width;
-  view.camera.height = scene.camera.height;
-  if (scene.camera.fStop > 0.0) {
-    // Thin lens: focal length from the field of view and the sensor width.
-    const double aspect = static_cast<double>(view.camera.width) / view.camera.height;
-    const double focal =
-        scene.camera.sensorWidth / aspect / (2.0 * std::tan(0.5 * view.camera.yfov));
-    view.camera.apertureRadius = focal / (2.0 * scene.camera.fStop);
-    view.camera.focusDistance = scene.camera.focusDistance > 0.0 ? scene.camera.focusDistance
-                                : scene.camera.node.empty()
-                                    ? (scene.camera.lookAt - scene.camera.position).norm()
-                                    : 1.0;
-  }
-  for (const auto& l : scene.lights) {
-    render::Light light;
-    switch (l.kind) {
-      case io::LightSpec::Kind::Directional:
-        light.kind = render::Light::Kind::Directional;
-        break;
-      case io::LightSpec::Kind::Point:
-        light.kind = render::Light::Kind::Point;
-        break;
-      case io::LightSpec::Kind::Area:
-        light.kind = render::Light::Kind::Area;
-        break;
-    }
-    light.direction = l.direction;
-    light.position = l.position;
-    light.color = l.color;
-    light.intensity = l.intensity;
-    light.angle = l.angle;
-    light.size = l.size;
-    light.shadow = l.shadow;
-    view.lights.push_back(light);
-  }
-  view.environment.color = scene.environment.color;
-  view.environment.intensity = scene.environment.intensity;
-  view.ground.enabled = scene.ground.enabled;
-  view.ground.height = scene.ground.height;
-  view.ground.size = scene.ground.size;
-  view.ground.color = scene.ground.color;
-  view.paper.frontColor = scene.paper.frontColor;
-  view.paper.backColor = scene.paper.backColor;
-  view.paper.transmittance =
-      scene.look.transmittance.value_or(render::paperTransmittance(scene.paper.thickness));
-  view.paper.creaseAngle = scene.look.creaseAngle;
-  return view;
-}
-
-namespace {
-
-// An axis-aligned box as 12 outward-facing triangles.
-render::PropMesh boxProp(const io::PropSpec& p) {
-  render::PropMesh m;
-  m.name = p.name;
-  m.color = p.color;
-  const Vec3 h = 0.5 * p.boxSize;
-  for (int i = 0; i < 8; ++i)
-    m.vertices.push_back(p.position + Vec3((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(),
-                                           (i & 4) ? h.z() : -h.z()));
-  m.triangles = {{0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}, {0, 1, 5}, {0, 5, 4},
-                 {2, 6, 7}, {2, 7, 3}, {0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}};
-  return m;
-}
-
-}  // namespace
-
-FrameViewBuilder::FrameViewBuilder(const io::SceneSpec& scene) : scene_(scene) {
-  if (!scene.look.texture.empty()) {
-    try {
-      texture_ = exporters::readPng(scene.look.texture);
-    } catch (const InputError& e) {
-      throw InputError(scene.file, scene.look.textureLine, "paper.texture", e.what());
-    }
-  } else {
-    texture_ = render::makeRuledPaperTexture(512, 512);
-  }
-  bool meshProps = false;
-  for (const auto& p : scene.props) {
-    if (p.node.empty())
-      boxes_.push_back(boxProp(p));
-    else
-      meshProps = true;
-  }
-  if (meshProps) {
-    // Mesh props move with their nodes: the animation file is read here (it
-    // must be reachable from where the frames are rendered).
-    animation_ =
-        std::make_shared<const io::AnimationScene>(io::AnimationScene::load(scene.animationFile));
-    io::checkAnimationNodes(scene, *animation_);
-    for (const auto& p : scene.props)
-      if (!p.node.empty()) {
-        const auto m = animation_->mesh(p.node);
-        render::PropMesh rest;
-        rest.name = p.name;
-        rest.color = p.color;
-        rest.vertices = m->vertices;
-        rest.triangles = m->triangles;
-        meshPropsAtRest_.push_back(std::move(rest));
-      }
-  }
-}
-
-FrameView FrameViewBuilder::build(const cache::FrameRecord& frame) const {
-  FrameView fv;
-  fv.scene = makeRenderScene(scene_, frame.camera);
-  fv.scene.paper.texture = texture_;
-  if (scene_.look.textureSize.x() > 0.0) {
-    fv.scene.paper.textureSize = scene_.look.textureSize;
-  } else {
-    // The texture spans the pattern's bounding box.
-    Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-    for (const auto& p : frame.pattern) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-    fv.scene.paper.textureSize = (hi - lo).cwiseMax(Vec2::Constant(1e-6));
-  }
-  fv.scene.props = boxes_;
-  if (animation_) {
-    std::size_t k = 0;
-    for (const auto& p : scene_.props) {
-      if (p.node.empty()) continue;
-      // The mesh is world space at t = 0: carry it along the node's motion.
-      const Mat4 motion = animation_->worldMatrix(p.node, frame.time) *
-                          animation_->worldMatrix(p.node, 0.0).inverse();
-      render::PropMesh m = meshPropsAtRest_[k++];
-      for (Vec3& v : m.vertices) v = (motion * v.homogeneous()).head<3>();
-      fv.scene.props.push_back(std::move(m));
-    }
-  }
-  fv.scene.sharpVertices = frame.singularVertices;
-  fv.sheet = sheetOfFrame(frame);
-  return fv;
-}
-
 ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   ShotReport report;
   report.outDir = !options.outDir.empty()     ? options.outDir
@@ -450,6 +299,8 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   }
   for (int f = scene.frameStart; f <= range.last; ++f)
     (void)cameraAt(scene, animation.get(), frameTime(scene, f));
+  // The look travels in the cache (texture, mesh props), read and checked now.
+  const std::vector<cache::ExtensionBlock> lookBlocks = lookHeaderBlocks(scene, animation.get());
   prepareOutputDir(report.outDir, "output");
   report.cachePath = (fs::path(report.outDir) / "cache.pcache").string();
   if (animation)
@@ -465,7 +316,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     report.framesDir = (fs::path(report.outDir) / "frames").string();
     prepareOutputDir(report.framesDir, "frames");
     renderer = std::make_unique<detail::FrameRenderer>(
-        scene, report.framesDir, options.debugStructure, options.rendering, seed);
+        scene, lookBlocks, report.framesDir, options.debugStructure, options.rendering, seed);
     report.renderBackend = backendName(options.rendering.backend);
   }
 
@@ -487,6 +338,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   header.paperName = scene.paper.name;
   header.paperThickness = scene.paper.thickness;
   for (const auto& h : rig.handles()) header.handleNames.push_back(h.name);
+  header.extensions = lookBlocks;
   cache::CacheWriter writer(report.cachePath, header);
 
   cache::FrameRecord record;
@@ -541,6 +393,9 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
       record.handleTargets.push_back(rig.target(h, t));
     }
     record.camera = cameraAt(scene, animation.get(), t);
+    record.extensions.clear();
+    if (auto motions = propMotionBlock(scene, animation.get(), t))
+      record.extensions.push_back(std::move(*motions));
     auto start = Clock::now();
     writer.append(record);
     report.stages["cache"].totalMs += msSince(start);
@@ -665,8 +520,8 @@ RenderReport renderCache(const std::string& cachePath, const RenderOptions& opti
   if ((options.rendering.contactSheet || options.rendering.movie) && !options.rendering.png)
     throw InputError("--contact-sheet/--movie", "need the PNG frames (drop --no-png)");
   prepareOutputDir(report.framesDir, "frames");
-  detail::FrameRenderer renderer(scene, report.framesDir, options.debugStructure, options.rendering,
-                                 header.seed);
+  detail::FrameRenderer renderer(scene, header.extensions, report.framesDir, options.debugStructure,
+                                 options.rendering, header.seed);
   Progress progress(std::string("crumple render (") + backendName(options.rendering.backend) + ")",
                     range.last - range.first + 1, options.log, options.interactive);
   for (int f = range.first; f <= range.last; ++f) {

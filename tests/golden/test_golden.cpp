@@ -52,6 +52,7 @@ bool blessing() {
 // The sample's one-frame cache and its scene at the given resolution.
 struct GoldenFrame {
   io::SceneSpec scene;
+  std::vector<cache::ExtensionBlock> headerBlocks;
   cache::FrameRecord frame;
 };
 
@@ -64,6 +65,7 @@ GoldenFrame loadFrame(const std::string& sample, int width, int height) {
                            /*checkFiles=*/true);
   g.scene.camera.width = width;
   g.scene.camera.height = height;
+  g.headerBlocks = reader.header().extensions;
   g.frame = reader.readFrame(0);
   return g;
 }
@@ -77,7 +79,7 @@ class Golden : public ::testing::TestWithParam<std::string> {};
 TEST_P(Golden, OsmesaIsByteExact) {
   const std::string sample = GetParam();
   const GoldenFrame g = loadFrame(sample, kWidth, kHeight);
-  const pipeline::FrameViewBuilder views(g.scene);
+  const pipeline::FrameViewBuilder views(g.scene, g.headerBlocks);
   const auto fv = views.build(g.frame);
   render::OsmesaRenderer renderer(kWidth, kHeight);
   const ImageRGBA8 image = renderer.render(fv.scene, fv.sheet);
@@ -101,7 +103,7 @@ TEST_P(Golden, OsmesaIsByteExact) {
 TEST_P(Golden, EmbreeIsWithinToleranceAndThreadIndependent) {
   const std::string sample = GetParam();
   const GoldenFrame g = loadFrame(sample, kWidth, kHeight);
-  const pipeline::FrameViewBuilder views(g.scene);
+  const pipeline::FrameViewBuilder views(g.scene, g.headerBlocks);
   const auto fv = views.build(g.frame);
   render::EmbreeRenderer renderer;
   render::PathTraceSettings settings;
@@ -137,7 +139,7 @@ TEST_P(Golden, EmbreeIsWithinToleranceAndThreadIndependent) {
 TEST_P(Golden, BackendsAgreeOnTheAlbedoPass) {
   const std::string sample = GetParam();
   const GoldenFrame g = loadFrame(sample, kAgreeWidth, kAgreeHeight);
-  const pipeline::FrameViewBuilder views(g.scene);
+  const pipeline::FrameViewBuilder views(g.scene, g.headerBlocks);
   const auto fv = views.build(g.frame);
   render::OsmesaRenderer osmesa(kAgreeWidth, kAgreeHeight);
   const ImageRGBA8 a = osmesa.render(fv.scene, fv.sheet, nullptr, render::RenderPass::Albedo);

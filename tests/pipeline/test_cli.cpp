@@ -232,6 +232,43 @@ TEST(Cli, ContactSheetAndMovie) {
   }
 }
 
+TEST(Cli, TheCacheCarriesTheTextureSoRenderingNeedsNothingElse) {
+  TempDir tmp;
+  writeSmallScene(tmp / "scene");
+  // A texture with a transparent window, and a box prop.
+  crumple::ImageRGBA8 tex(16, 16);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) {
+      std::uint8_t* p = tex.at(x, y);
+      p[0] = static_cast<std::uint8_t>(16 * x);
+      p[1] = static_cast<std::uint8_t>(16 * y);
+      p[2] = 200;
+      p[3] = (x >= 6 && x < 10 && y >= 6 && y < 10) ? 0 : 255;
+    }
+  crumple::exporters::writePng((tmp / "scene/print.png").string(), tex);
+  auto scene = readFile(tmp / "scene/scene.toml");
+  scene.replace(scene.find("[paper]\n"), 8, "[paper]\ntexture = \"print.png\"\n");
+  scene += "[[props]]\nshape = \"box\"\nsize = [5, 5, 5]\nposition = [8, 2.5, 0]\n";
+  writeFile(tmp / "scene/scene.toml", scene);
+  ASSERT_EQ(runCrumple("run " + (tmp / "scene").string() + " --out " + (tmp / "a").string()).status,
+            0);
+  fs::remove_all(tmp / "scene");  // the texture file is gone too
+  const auto r = runCrumple("render " + (tmp / "a/cache.pcache").string() + " --frames 4-4 --out " +
+                            (tmp / "b").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(readFile(tmp / "b/0004.png"), readFile(tmp / "a/frames/0004.png"));
+  // A texture that is not a PNG is an input error before anything is written.
+  writeSmallScene(tmp / "bad");
+  writeFile(tmp / "bad/print.png", "not a png");
+  auto bad = readFile(tmp / "bad/scene.toml");
+  bad.replace(bad.find("[paper]\n"), 8, "[paper]\ntexture = \"print.png\"\n");
+  writeFile(tmp / "bad/scene.toml", bad);
+  const auto e = runCrumple("run " + (tmp / "bad").string() + " --out " + (tmp / "c").string());
+  EXPECT_EQ(e.status, 2) << e.output;
+  EXPECT_NE(e.output.find("paper.texture"), std::string::npos) << e.output;
+  EXPECT_FALSE(fs::exists(tmp / "c/cache.pcache"));
+}
+
 // Every bad input exits 2, names the file and the problem, and leaves no
 // cache or frames behind.
 class BadInput : public ::testing::Test {

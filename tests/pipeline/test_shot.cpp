@@ -485,9 +485,15 @@ size = [0.5, 0.25]
   frame.singularVertices = {1};
   frame.camera.position = Vec3(0, 1, 1);
   frame.camera.yfov = 0.7;
-  const pipeline::FrameViewBuilder views(scene);
+  // The cache carries the look: the props' rest meshes in the header, their
+  // motions in each frame (lookHeaderBlocks, propMotionBlock).
+  const auto anim = io::AnimationScene::load(scene.animationFile);
+  const auto headerBlocks = pipeline::lookHeaderBlocks(scene, &anim);
+  ASSERT_EQ(headerBlocks.size(), 1u) << "no texture, one block of prop meshes";
+  const pipeline::FrameViewBuilder views(scene, headerBlocks);
   for (const double t : {0.0, 0.5}) {
     frame.time = t;
+    frame.extensions = {*pipeline::propMotionBlock(scene, &anim, t)};
     const auto fv = views.build(frame);
     ASSERT_EQ(fv.scene.props.size(), 2u);
     const auto& box = fv.scene.props[0];  // boxes first, then mesh props
@@ -508,9 +514,14 @@ size = [0.5, 0.25]
     EXPECT_TRUE(fv.scene.lights[0].size.isApprox(Vec2(0.5, 0.25)));
     EXPECT_TRUE(fv.scene.paper.textureSize.isApprox(Vec2(0.2, 0.3)));
   }
+  frame.extensions.clear();
+  EXPECT_THROW((void)views.build(frame), CorruptDataError) << "a frame without its prop motions";
   // The default transmittance follows the preset's thickness (90 um: 0.23).
   const auto plain = io::parseScene("[sheet]\nwidth = 0.2\nheight = 0.3\n", "p.toml", ".");
-  const auto fv = pipeline::FrameViewBuilder(plain).build(frame);
+  EXPECT_TRUE(pipeline::lookHeaderBlocks(plain, nullptr).empty());
+  EXPECT_FALSE(pipeline::propMotionBlock(plain, nullptr, 0.0).has_value());
+  frame.extensions.clear();
+  const auto fv = pipeline::FrameViewBuilder(plain, {}).build(frame);
   EXPECT_NEAR(fv.scene.paper.transmittance, std::exp(-90e-6 / 62e-6), 1e-12);
   EXPECT_EQ(fv.scene.camera.apertureRadius, 0.0) << "pinhole without f_stop";
 }

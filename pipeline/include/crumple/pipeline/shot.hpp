@@ -126,24 +126,39 @@ render::RenderScene makeRenderScene(const io::SceneSpec& scene, const cache::Cam
 
 // What the renderers draw for one cached frame: the view (camera, lights,
 // environment, ground, paper look with its texture, props, this frame's sharp
-// vertices) and the sheet. Built once per scene (textures and props are
-// loaded by the constructor), then once per frame.
+// vertices) and the sheet. Built once per shot from the scene and the cache
+// header's extension blocks (the paper texture and the mesh props' rest
+// meshes, lookHeaderBlocks), then once per frame (the props' motions come
+// from the frame's block, propMotionBlock): rendering needs nothing but the
+// cache. Keeps a reference to `scene`. Throws CorruptDataError on malformed
+// blocks, InputError on a texture that is not a PNG.
 struct FrameView {
   render::RenderScene scene;
   mesh::SheetMesh sheet;
 };
 class FrameViewBuilder {
  public:
-  explicit FrameViewBuilder(const io::SceneSpec& scene);
+  FrameViewBuilder(const io::SceneSpec& scene,
+                   const std::vector<cache::ExtensionBlock>& headerBlocks);
   FrameView build(const cache::FrameRecord& frame) const;
 
  private:
   const io::SceneSpec& scene_;
   ImageRGBA8 texture_;
   std::vector<render::PropMesh> boxes_;
-  std::shared_ptr<const io::AnimationScene> animation_;  // mesh props only
   std::vector<render::PropMesh> meshPropsAtRest_;
 };
+
+// The cache header's look blocks (docs/PCACHE.md): "PTEX", the [paper]
+// texture file's PNG bytes; "PROP", the rest meshes (world space at t = 0) of
+// the [[props]] mesh nodes. Throws InputError (scene file and line) for an
+// unreadable texture or a node without a mesh.
+std::vector<cache::ExtensionBlock> lookHeaderBlocks(const io::SceneSpec& scene,
+                                                    const io::AnimationScene* animation);
+// A frame's "PRPM" block: each mesh prop's motion from its rest mesh at time
+// t (s); nullopt when the scene has no mesh props.
+std::optional<cache::ExtensionBlock> propMotionBlock(const io::SceneSpec& scene,
+                                                     const io::AnimationScene* animation, double t);
 
 // Closing summary line(s) for the terminal, and summary.json text.
 std::string summaryText(const ShotReport& report);
