@@ -897,7 +897,10 @@ ImageRGBAF EmbreeRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
 }
 
 EmbreeRenderer::EmbreeRenderer() : impl_(std::make_unique<Impl>()) {
-  impl_->device.reset(rtcNewDevice(nullptr));
+  // Embree's own (TBB) threads build the BVH: as many as crumple may use, so
+  // that `--threads 1` on a farm node keeps to one core.
+  const std::string config = "threads=" + std::to_string(threadCount());
+  impl_->device.reset(rtcNewDevice(config.c_str()));
   if (!impl_->device)
     throw std::runtime_error(std::string("EmbreeRenderer: rtcNewDevice failed: ") +
                              errorName(rtcGetDeviceError(nullptr)));

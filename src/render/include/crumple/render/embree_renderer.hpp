@@ -39,8 +39,9 @@ struct PathTraceSettings {
 
 class EmbreeRenderer {
  public:
-  // Creates the Embree device. Throws std::runtime_error naming Embree's
-  // error when it cannot.
+  // Creates the Embree device; its BVH builds use crumple::threadCount()
+  // threads (as set when the renderer is created). Throws std::runtime_error
+  // naming Embree's error when it cannot.
   EmbreeRenderer();
   ~EmbreeRenderer();
   EmbreeRenderer(const EmbreeRenderer&) = delete;
