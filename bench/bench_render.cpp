@@ -55,7 +55,6 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
-#include <regex>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -70,6 +69,7 @@
 #include "crumple/pipeline/shot.hpp"
 #include "crumple/render/embree_renderer.hpp"
 #include "crumple/render/view.hpp"
+#include "json_number.hpp"
 
 namespace fs = std::filesystem;
 using namespace crumple;
@@ -379,9 +379,7 @@ std::string readText(const fs::path& path) {
 }
 
 double jsonNumber(const std::string& text, const std::string& key) {
-  const std::regex re("\"" + key + "\":\\s*(-?[0-9.eE+-]+)");
-  std::smatch m;
-  return std::regex_search(text, m, re) ? std::stod(m[1].str()) : -1.0;
+  return bench::jsonNumber(text, key, -1.0);
 }
 
 Timed renderCycles(const fs::path& dir, const std::string& name, int spp, std::uint64_t seed,

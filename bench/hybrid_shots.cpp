@@ -15,13 +15,13 @@
 #include <fstream>
 #include <iterator>
 #include <map>
-#include <regex>
 #include <string>
 #include <vector>
 
 #include "crumple/core/error.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/shot.hpp"
+#include "json_number.hpp"
 
 namespace fs = std::filesystem;
 using namespace crumple;
@@ -41,9 +41,7 @@ struct Run {
 
 // The figures of a shot that stopped early, from the summary.json it left.
 double jsonNumber(const std::string& text, const std::string& key) {
-  const std::regex re("\"" + key + "\":(-?[0-9.eE+-]+)");
-  std::smatch m;
-  return std::regex_search(text, m, re) ? std::stod(m[1].str()) : 0.0;
+  return bench::jsonNumber(text, key, 0.0);
 }
 
 Run fromSummary(const std::string& outDir, const std::string& error) {
