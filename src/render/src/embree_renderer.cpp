@@ -190,81 +190,17 @@ struct FrameData {
 
 // --- input validation -----------------------------------------------------------
 
-bool finite(const Vec3& v) { return v.allFinite(); }
-
-[[noreturn]] void invalid(const std::string& what) {
-  throw std::invalid_argument("EmbreeRenderer: " + what);
-}
-
 // Checks everything render() relies on (std::invalid_argument otherwise).
 void validateInput(const RenderScene& scene, const mesh::SheetMesh& sheet,
                    const PathTraceSettings& settings) {
-  if (settings.samplesPerPixel < 1) invalid("samplesPerPixel must be >= 1");
-  if (settings.maxBounces < 0) invalid("maxBounces must be >= 0");
+  if (settings.samplesPerPixel < 1)
+    throw std::invalid_argument("EmbreeRenderer: samplesPerPixel must be >= 1");
+  if (settings.maxBounces < 0)
+    throw std::invalid_argument("EmbreeRenderer: maxBounces must be >= 0");
   const Camera& cam = scene.camera;
-  if (cam.width <= 0 || cam.height <= 0) invalid("camera width and height must be positive");
-  if (static_cast<long long>(cam.width) * cam.height > (1LL << 31) / 4) invalid("image too large");
-  if (!finite(cam.position) || !cam.rotation.coeffs().allFinite() || !(cam.rotation.norm() > 0.0))
-    invalid("camera pose is not finite");
-  if (!(cam.yfov > 0.0 && cam.yfov < std::numbers::pi)) invalid("camera needs 0 < yfov < pi");
-  if (!(cam.apertureRadius >= 0.0) || !std::isfinite(cam.apertureRadius))
-    invalid("camera apertureRadius must be finite and >= 0");
-  if (cam.apertureRadius > 0.0 && !(cam.focusDistance > 0.0 && std::isfinite(cam.focusDistance)))
-    invalid("camera focusDistance must be finite and > 0 with a lens");
-  for (const Light& l : scene.lights) {
-    if (!finite(l.color) || !std::isfinite(l.intensity) || !finite(l.position) ||
-        !finite(l.direction) || !std::isfinite(l.angle) || !l.size.allFinite())
-      invalid("light has non-finite parameters");
-    if (l.kind != Light::Kind::Point && !(l.direction.norm() > 0.0))
-      invalid("directional or area light with zero direction");
-    if (l.kind == Light::Kind::Directional && !(l.angle >= 0.0 && l.angle < std::numbers::pi))
-      invalid("directional light angle must be in [0, pi)");
-    if (l.kind == Light::Kind::Area && !(l.size.x() > 0.0 && l.size.y() > 0.0))
-      invalid("area light size must be > 0");
-  }
-  if (!finite(scene.environment.color) || !std::isfinite(scene.environment.intensity))
-    invalid("environment is not finite");
-  if (scene.ground.enabled && !(std::isfinite(scene.ground.height) && scene.ground.size > 0.0 &&
-                                std::isfinite(scene.ground.size) && finite(scene.ground.color)))
-    invalid("ground needs a finite height, colour and size > 0");
-  const PaperLook& paper = scene.paper;
-  if (!(paper.textureSize.x() > 0.0 && paper.textureSize.y() > 0.0) ||
-      !paper.textureSize.allFinite())
-    invalid("paper textureSize must be positive");
-  if (!paper.texture.pixels.empty() &&
-      (paper.texture.width <= 0 || paper.texture.height <= 0 ||
-       paper.texture.pixels.size() !=
-           static_cast<std::size_t>(paper.texture.width) * paper.texture.height * 4))
-    invalid("paper texture size does not match its pixels");
-  if (!finite(paper.frontColor) || !finite(paper.backColor))
-    invalid("paper colours are not finite");
-  if (!(paper.transmittance >= 0.0 && paper.transmittance <= 1.0))
-    invalid("paper transmittance must be in [0, 1]");
-  if (!std::isfinite(paper.creaseAngle)) invalid("paper creaseAngle is not finite");
-  if (sheet.positions.size() != sheet.pattern.size())
-    invalid("sheet positions and pattern differ in size");
-  const auto n = static_cast<long long>(sheet.positions.size());
-  for (const auto& t : sheet.triangles)
-    for (const int v : t)
-      if (v < 0 || v >= n) invalid("sheet triangle index out of range");
-  for (std::size_t i = 0; i < sheet.positions.size(); ++i)
-    if (!finite(sheet.positions[i]) || !sheet.pattern[i].allFinite())
-      invalid("sheet vertex " + std::to_string(i) + " is not finite");
-  for (const PropMesh& prop : scene.props) {
-    if (!finite(prop.color)) invalid("prop '" + prop.name + "' colour is not finite");
-    for (const Vec3& v : prop.vertices)
-      if (!finite(v)) invalid("prop '" + prop.name + "' has a non-finite vertex");
-    const auto nv = static_cast<long long>(prop.vertices.size());
-    for (const auto& t : prop.triangles)
-      for (const int v : t)
-        if (v < 0 || v >= nv) invalid("prop '" + prop.name + "' triangle index out of range");
-  }
-}
-
-const ImageRGBA8& ruledTexture() {
-  // A4 proportions, ~0.2 mm per texel over the default 0.21 x 0.297 m (as the preview).
-  static const ImageRGBA8 tex = makeRuledPaperTexture(1024, 1448);
-  return tex;
+  if (static_cast<long long>(cam.width) * cam.height > (1LL << 31) / 4)
+    throw std::invalid_argument("EmbreeRenderer: image too large");
+  validateRenderInput(scene, sheet, "EmbreeRenderer");
 }
 
 // True when some texel's alpha is below 0.5, i.e. the bilinear alpha can be.
@@ -779,7 +715,7 @@ ImageRGBAF EmbreeRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
 
   // The sheet.
   const ImageRGBA8& texture =
-      scene.paper.texture.pixels.empty() ? ruledTexture() : scene.paper.texture;
+      scene.paper.texture.pixels.empty() ? defaultPaperTexture() : scene.paper.texture;
   const bool cutOuts = !scene.paper.texture.pixels.empty() && hasCutOuts(texture);
   f.sheet.texture = &texture;
   f.sheet.front = toV3(scene.paper.frontColor);

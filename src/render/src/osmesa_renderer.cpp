@@ -335,8 +335,6 @@ Mat4 perspective(double halfAngle, double n, double f) {
   return p;
 }
 
-bool finite(const Vec3& v) { return v.allFinite(); }
-
 // Owns the OSMesa context; every GL object lives and dies with it.
 class OsmesaContext {
  public:
@@ -654,73 +652,17 @@ struct OsmesaRenderer::Impl {
 
 namespace {
 
+// The preview's own checks on top of validateRenderInput.
 void validateInput(const RenderScene& scene, const mesh::SheetMesh& sheet, int width, int height) {
   const Camera& cam = scene.camera;
   if (cam.width != width || cam.height != height)
     throw std::invalid_argument("OsmesaRenderer: camera is " + std::to_string(cam.width) + "x" +
                                 std::to_string(cam.height) + " but the renderer is " +
                                 std::to_string(width) + "x" + std::to_string(height));
-  if (!finite(cam.position) || !cam.rotation.coeffs().allFinite() || !(cam.rotation.norm() > 0.0))
-    throw std::invalid_argument("OsmesaRenderer: camera pose is not finite");
-  if (!(cam.yfov > 0.0 && cam.yfov < std::numbers::pi) || !(cam.znear > 0.0) ||
-      !(cam.zfar > cam.znear) || !std::isfinite(cam.zfar))
-    throw std::invalid_argument("OsmesaRenderer: camera needs 0 < yfov < pi, 0 < znear < zfar");
   if (static_cast<int>(scene.lights.size()) > kMaxLights)
     throw std::invalid_argument("OsmesaRenderer: at most " + std::to_string(kMaxLights) +
                                 " lights");
-  for (const Light& l : scene.lights) {
-    if (!finite(l.color) || !std::isfinite(l.intensity) || !finite(l.position) ||
-        !finite(l.direction))
-      throw std::invalid_argument("OsmesaRenderer: light has non-finite parameters");
-    if (l.kind != Light::Kind::Point && !(l.direction.norm() > 0.0))
-      throw std::invalid_argument("OsmesaRenderer: directional or area light with zero direction");
-    if (l.kind == Light::Kind::Area && !(l.size.allFinite() && l.size.minCoeff() > 0.0))
-      throw std::invalid_argument("OsmesaRenderer: area light needs a finite size > 0");
-  }
-  if (!finite(scene.environment.color) || !std::isfinite(scene.environment.intensity))
-    throw std::invalid_argument("OsmesaRenderer: environment is not finite");
-  for (const PropMesh& prop : scene.props) {
-    for (const Vec3& v : prop.vertices)
-      if (!finite(v))
-        throw std::invalid_argument("OsmesaRenderer: prop '" + prop.name +
-                                    "' has a non-finite vertex");
-    for (const auto& t : prop.triangles)
-      for (const int v : t)
-        if (v < 0 || static_cast<std::size_t>(v) >= prop.vertices.size())
-          throw std::invalid_argument("OsmesaRenderer: prop '" + prop.name +
-                                      "' triangle index out of range");
-  }
-  if (scene.ground.enabled && !(std::isfinite(scene.ground.height) && scene.ground.size > 0.0 &&
-                                std::isfinite(scene.ground.size) && finite(scene.ground.color)))
-    throw std::invalid_argument("OsmesaRenderer: ground needs a finite height and size > 0");
-  const PaperLook& paper = scene.paper;
-  if (!(paper.textureSize.x() > 0.0 && paper.textureSize.y() > 0.0) ||
-      !paper.textureSize.allFinite())
-    throw std::invalid_argument("OsmesaRenderer: paper textureSize must be positive");
-  if (!(paper.transmittance >= 0.0 && paper.transmittance < 1.0))
-    throw std::invalid_argument("OsmesaRenderer: paper transmittance must be in [0, 1)");
-  if (!paper.texture.pixels.empty() &&
-      (paper.texture.width <= 0 || paper.texture.height <= 0 ||
-       paper.texture.pixels.size() !=
-           static_cast<std::size_t>(paper.texture.width) * paper.texture.height * 4))
-    throw std::invalid_argument("OsmesaRenderer: paper texture size does not match its pixels");
-  if (sheet.positions.size() != sheet.pattern.size())
-    throw std::invalid_argument("OsmesaRenderer: sheet positions and pattern differ in size");
-  const auto n = static_cast<int>(sheet.positions.size());
-  for (const auto& t : sheet.triangles)
-    for (const int v : t)
-      if (v < 0 || v >= n)
-        throw std::invalid_argument("OsmesaRenderer: triangle index out of range");
-  for (std::size_t i = 0; i < sheet.positions.size(); ++i)
-    if (!finite(sheet.positions[i]) || !sheet.pattern[i].allFinite())
-      throw std::invalid_argument("OsmesaRenderer: sheet vertex " + std::to_string(i) +
-                                  " is not finite");
-}
-
-const ImageRGBA8& ruledTexture() {
-  // A4 proportions, ~0.2 mm per texel over the default 0.21 x 0.297 m.
-  static const ImageRGBA8 tex = makeRuledPaperTexture(1024, 1448);
-  return tex;
+  validateRenderInput(scene, sheet, "OsmesaRenderer");
 }
 
 }  // namespace
@@ -839,7 +781,7 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
 
   // The paper texture (unit 0), needed by the shadow pass of a cut paper.
   if (scene.paper.texture.pixels.empty())
-    uploadTexture(ruledTexture(), true);
+    uploadTexture(defaultPaperTexture(), true);
   else
     uploadTexture(scene.paper.texture, false);
   const bool alphaCut = textureHasCut;

@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
+#include <string>
+
+#include "crumple/mesh/sheet_mesh.hpp"
 
 namespace crumple::render {
 
@@ -271,6 +275,78 @@ Vec4 sampleTexture(const ImageRGBA8& texture, const Vec2& uv) {
   };
   return (1.0 - ay) * ((1.0 - ax) * texel(x0, y0) + ax * texel(x1, y0)) +
          ay * ((1.0 - ax) * texel(x0, y1) + ax * texel(x1, y1));
+}
+
+void validateRenderInput(const RenderScene& scene, const mesh::SheetMesh& sheet, const char* who) {
+  const auto invalid = [who](const std::string& what) {
+    throw std::invalid_argument(std::string(who) + ": " + what);
+  };
+  const auto finite = [](const Vec3& v) { return v.allFinite(); };
+  const Camera& cam = scene.camera;
+  if (cam.width <= 0 || cam.height <= 0) invalid("camera width and height must be positive");
+  if (!finite(cam.position) || !cam.rotation.coeffs().allFinite() || !(cam.rotation.norm() > 0.0))
+    invalid("camera pose is not finite");
+  if (!(cam.yfov > 0.0 && cam.yfov < std::numbers::pi)) invalid("camera needs 0 < yfov < pi");
+  if (!(cam.znear > 0.0) || !(cam.zfar > cam.znear) || !std::isfinite(cam.zfar))
+    invalid("camera needs 0 < znear < zfar");
+  if (!(cam.apertureRadius >= 0.0) || !std::isfinite(cam.apertureRadius))
+    invalid("camera apertureRadius must be finite and >= 0");
+  if (cam.apertureRadius > 0.0 && !(cam.focusDistance > 0.0 && std::isfinite(cam.focusDistance)))
+    invalid("camera focusDistance must be finite and > 0 with a lens");
+  for (const Light& l : scene.lights) {
+    if (!finite(l.color) || !std::isfinite(l.intensity) || !finite(l.position) ||
+        !finite(l.direction) || !std::isfinite(l.angle) || !l.size.allFinite())
+      invalid("light has non-finite parameters");
+    if (l.kind != Light::Kind::Point && !(l.direction.norm() > 0.0))
+      invalid("directional or area light with zero direction");
+    if (l.kind == Light::Kind::Directional && !(l.angle >= 0.0 && l.angle < std::numbers::pi))
+      invalid("directional light angle must be in [0, pi)");
+    if (l.kind == Light::Kind::Area && !(l.size.x() > 0.0 && l.size.y() > 0.0))
+      invalid("area light size must be > 0");
+  }
+  if (!finite(scene.environment.color) || !std::isfinite(scene.environment.intensity))
+    invalid("environment is not finite");
+  if (scene.ground.enabled && !(std::isfinite(scene.ground.height) && scene.ground.size > 0.0 &&
+                                std::isfinite(scene.ground.size) && finite(scene.ground.color)))
+    invalid("ground needs a finite height, colour and size > 0");
+  const PaperLook& paper = scene.paper;
+  if (!(paper.textureSize.x() > 0.0 && paper.textureSize.y() > 0.0) ||
+      !paper.textureSize.allFinite())
+    invalid("paper textureSize must be positive");
+  if (!paper.texture.pixels.empty() &&
+      (paper.texture.width <= 0 || paper.texture.height <= 0 ||
+       paper.texture.pixels.size() !=
+           static_cast<std::size_t>(paper.texture.width) * paper.texture.height * 4))
+    invalid("paper texture size does not match its pixels");
+  if (!finite(paper.frontColor) || !finite(paper.backColor))
+    invalid("paper colours are not finite");
+  if (!(paper.transmittance >= 0.0 && paper.transmittance <= 1.0))
+    invalid("paper transmittance must be in [0, 1]");
+  if (!std::isfinite(paper.creaseAngle)) invalid("paper creaseAngle is not finite");
+  if (sheet.positions.size() != sheet.pattern.size())
+    invalid("sheet positions and pattern differ in size");
+  const auto n = static_cast<long long>(sheet.positions.size());
+  for (const auto& t : sheet.triangles)
+    for (const int v : t)
+      if (v < 0 || v >= n) invalid("sheet triangle index out of range");
+  for (std::size_t i = 0; i < sheet.positions.size(); ++i)
+    if (!finite(sheet.positions[i]) || !sheet.pattern[i].allFinite())
+      invalid("sheet vertex " + std::to_string(i) + " is not finite");
+  for (const PropMesh& prop : scene.props) {
+    if (!finite(prop.color)) invalid("prop '" + prop.name + "' colour is not finite");
+    for (const Vec3& v : prop.vertices)
+      if (!finite(v)) invalid("prop '" + prop.name + "' has a non-finite vertex");
+    const auto nv = static_cast<long long>(prop.vertices.size());
+    for (const auto& t : prop.triangles)
+      for (const int v : t)
+        if (v < 0 || v >= nv) invalid("prop '" + prop.name + "' triangle index out of range");
+  }
+}
+
+const ImageRGBA8& defaultPaperTexture() {
+  // A4 proportions, ~0.2 mm per texel over the default 0.21 x 0.297 m.
+  static const ImageRGBA8 tex = makeRuledPaperTexture(1024, 1448);
+  return tex;
 }
 
 }  // namespace crumple::render

@@ -11,6 +11,10 @@
 #include "crumple/core/image.hpp"
 #include "crumple/core/types.hpp"
 
+namespace crumple::mesh {
+struct SheetMesh;
+}  // namespace crumple::mesh
+
 namespace crumple::render {
 
 struct Camera {
@@ -210,6 +214,18 @@ std::vector<std::array<Vec3, 3>> shadingNormals(const std::vector<Vec3>& positio
 // first row in memory, i.e. the image's top row): linear RGB (each texel
 // decoded before filtering, like GL_SRGB8_ALPHA8) and alpha in [0, 1].
 Vec4 sampleTexture(const ImageRGBA8& texture, const Vec2& uv);
+
+// The checks both renderers make before drawing (std::invalid_argument
+// "<who>: <what is wrong>"): a finite camera with 0 < yfov < pi, 0 < znear <
+// zfar and a valid lens; finite lights (directions non-zero, sun angle in [0,
+// pi), area sizes > 0), environment, ground, paper look (texture size
+// consistent, transmittance in [0, 1]) and props; a sheet whose triangles
+// index its finite vertices.
+void validateRenderInput(const RenderScene& scene, const mesh::SheetMesh& sheet, const char* who);
+
+// The paper texture when PaperLook::texture is empty: makeRuledPaperTexture
+// at 1024 x 1448 (A4 proportions), made once.
+const ImageRGBA8& defaultPaperTexture();
 
 // The texture coordinates of a pattern point (the convention above).
 inline Vec2 patternToUv(const Vec2& pattern, const Vec2& textureSize) {
