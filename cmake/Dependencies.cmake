@@ -12,6 +12,9 @@ find_package(tomlplusplus REQUIRED CONFIG)  # target tomlplusplus::tomlplusplus
 # PRIVATE: only src/mesh/src/delaunay.cpp includes CGAL.
 set(CGAL_DO_NOT_WARN_ABOUT_CMAKE_BUILD_TYPE TRUE)
 find_package(CGAL 5.5 REQUIRED CONFIG)
+# FCL 0.7 (collider BVHs; target `fcl`, no namespace). Its asserts are live:
+# only proximity queries with a margin are used (../shared/DEPENDENCIES.md).
+find_package(fcl 0.7 REQUIRED CONFIG)
 # Embree 3 (the path tracer; target `embree`, header <embree3/rtcore.h>).
 find_package(embree 3.13 REQUIRED CONFIG)
 # OpenEXR 3.1 (linear frames; targets OpenEXR::OpenEXR).

@@ -1,0 +1,72 @@
+#pragma once
+// Rigid colliders the sheet must stay outside of (issue 5: tables, props,
+// fingers): analytic planes, boxes and spheres, and triangle meshes held as
+// FCL BVH models, each with a pose updated per substep when animated.
+// Proximity queries with a margin (the paper's thickness) are the contact
+// primitive: FCL is the broad phase for meshes, the distances are computed
+// exactly here (FCL's own signed distances are unreliable on overlap, see
+// ../shared/DEPENDENCIES.md).
+#include <array>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "crumple/core/types.hpp"
+
+namespace crumple::sim {
+
+// A collider's shape in its own (local) frame.
+struct ColliderShape {
+  enum class Kind { Plane, Box, Sphere, Mesh };
+  Kind kind = Kind::Plane;
+  // Plane: the local XZ plane; the solid is the half-space y < 0 (normal +Y).
+  Vec3 halfExtents = Vec3::Constant(0.05);  // Box: centred on the local origin
+  double radius = 0.05;                     // Sphere: centred on the local origin
+  // Mesh: local vertices and triangles. The solid side of a triangle is
+  // behind its face (counter-clockwise front); open meshes (a table top)
+  // work: only points within the margin of a triangle are found.
+  std::vector<Vec3> vertices;
+  std::vector<std::array<int, 3>> triangles;
+};
+
+// The nearest collider surface point to a query point.
+struct ColliderContact {
+  int collider = -1;
+  double distance = 0.0;        // signed distance from the surface, negative inside
+  Vec3 point = Vec3::Zero();    // closest point on the collider's surface (world)
+  Vec3 normal = Vec3::UnitY();  // unit, out of the collider (world)
+};
+
+class ColliderSet {
+ public:
+  ColliderSet();
+  ~ColliderSet();
+  ColliderSet(ColliderSet&&) noexcept;
+  ColliderSet& operator=(ColliderSet&&) noexcept;
+
+  // Adds a collider and returns its index. Throws std::invalid_argument for a
+  // non-finite or degenerate shape (box extents or radius <= 0, a mesh
+  // without triangles or with indices out of range).
+  int add(std::string name, ColliderShape shape, const Pose& pose);
+  // Moves an (animated) collider; its BVH is kept, only the pose changes.
+  void setPose(int collider, const Pose& pose);
+  std::size_t size() const;
+  const std::string& name(int collider) const;
+
+  // Among the colliders p is within `margin` of (or inside of: analytic
+  // shapes; meshes only within the margin of a triangle), the one with the
+  // lowest signed distance (the deepest penetration); nullopt when there is
+  // none. Ties go to the lowest collider index (deterministic).
+  std::optional<ColliderContact> nearest(const Vec3& p, double margin) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Closest point of triangle (a, b, c) to p (Ericson, Real-Time Collision
+// Detection, 5.1.5).
+Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
+}  // namespace crumple::sim

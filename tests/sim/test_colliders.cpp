@@ -1,0 +1,138 @@
+// Collider proximity queries (issue 5, item 1): analytic planes, boxes and
+// spheres, FCL-backed meshes, animated poses.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "crumple/core/rng.hpp"
+#include "crumple/sim/colliders.hpp"
+
+namespace crumple::sim {
+namespace {
+
+Pose at(const Vec3& p, const Quat& q = Quat::Identity()) { return {p, q}; }
+
+ColliderShape box(const Vec3& h) {
+  ColliderShape s;
+  s.kind = ColliderShape::Kind::Box;
+  s.halfExtents = h;
+  return s;
+}
+
+ColliderShape sphere(double r) {
+  ColliderShape s;
+  s.kind = ColliderShape::Kind::Sphere;
+  s.radius = r;
+  return s;
+}
+
+// A closed cube [-h, h]^3 as 12 outward-facing triangles.
+ColliderShape cubeMesh(double h) {
+  ColliderShape s;
+  s.kind = ColliderShape::Kind::Mesh;
+  for (int i = 0; i < 8; ++i)
+    s.vertices.emplace_back((i & 1) ? h : -h, (i & 2) ? h : -h, (i & 4) ? h : -h);
+  s.triangles = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                 {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+  return s;
+}
+
+TEST(Colliders, TiltedPlaneGivesSignedDistanceAndNormal) {
+  ColliderSet set;
+  const Quat tilt(Eigen::AngleAxisd(0.3, Vec3::UnitZ()));
+  set.add("table", ColliderShape{}, at(Vec3(0, 1, 0), tilt));
+  const Vec3 n = tilt * Vec3::UnitY();
+  const Vec3 onPlane = Vec3(0, 1, 0) + tilt * Vec3(0.2, 0, 0.1);
+  const Vec3 above = onPlane + 0.004 * n;
+  const auto c = set.nearest(above, 0.01);
+  ASSERT_TRUE(c.has_value());
+  EXPECT_NEAR(c->distance, 0.004, 1e-12);
+  EXPECT_TRUE(c->normal.isApprox(n, 1e-12));
+  EXPECT_TRUE((c->point + 0.004 * n).isApprox(above, 1e-12));
+  EXPECT_FALSE(set.nearest(onPlane + 0.02 * n, 0.01).has_value()) << "beyond the margin";
+  const auto below = set.nearest(onPlane - 0.5 * n, 0.01);
+  ASSERT_TRUE(below.has_value()) << "a half-space is solid all the way down";
+  EXPECT_NEAR(below->distance, -0.5, 1e-12);
+}
+
+TEST(Colliders, BoxAndSphereInsideAndOutside) {
+  ColliderSet set;
+  set.add("box", box(Vec3(0.1, 0.2, 0.3)), at(Vec3(1, 0, 0)));
+  set.add("ball", sphere(0.25), at(Vec3(-1, 0, 0)));
+  // Outside the box near an edge: distance to the clamped point.
+  auto c = set.nearest(Vec3(1.1 + 0.003, 0.2 + 0.004, 0.0), 0.01);
+  ASSERT_TRUE(c.has_value());
+  EXPECT_EQ(c->collider, 0);
+  EXPECT_NEAR(c->distance, 0.005, 1e-12);
+  EXPECT_TRUE(c->normal.isApprox(Vec3(0.6, 0.8, 0.0), 1e-12));
+  // Inside the box: the nearest face, negative distance.
+  c = set.nearest(Vec3(1.09, 0.0, 0.0), 0.01);
+  ASSERT_TRUE(c.has_value());
+  EXPECT_NEAR(c->distance, -0.01, 1e-12);
+  EXPECT_TRUE(c->normal.isApprox(Vec3::UnitX(), 1e-12));
+  EXPECT_TRUE(c->point.isApprox(Vec3(1.1, 0.0, 0.0), 1e-12));
+  // The sphere, and its pose moved by an animation.
+  c = set.nearest(Vec3(-1, 0.255, 0), 0.01);
+  ASSERT_TRUE(c.has_value());
+  EXPECT_EQ(c->collider, 1);
+  EXPECT_NEAR(c->distance, 0.005, 1e-12);
+  set.setPose(1, at(Vec3(-1, 0.5, 0)));
+  EXPECT_NEAR(set.nearest(Vec3(-1, 0.755, 0), 0.01)->distance, 0.005, 1e-12);
+  EXPECT_FALSE(set.nearest(Vec3(-1, -0.255, 0), 0.01).has_value()) << "the ball moved away";
+  EXPECT_EQ(set.name(1), "ball");
+}
+
+TEST(Colliders, MeshMatchesTheAnalyticBoxNearItsSurface) {
+  // The cube mesh against the analytic box of the same size, rotated and
+  // moved: near the surface (within the margin) both give the same signed
+  // distance and closest point (the FCL broad phase misses no triangle).
+  const Quat q(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()));
+  const Pose pose = at(Vec3(0.3, -0.2, 0.5), q);
+  ColliderSet mesh, analytic;
+  mesh.add("cube", cubeMesh(0.1), pose);
+  analytic.add("cube", box(Vec3::Constant(0.1)), pose);
+  const CounterRng rng(1, 0, RngPurpose::Generic);
+  int compared = 0;
+  for (std::uint64_t i = 0; i < 400; ++i) {
+    const Vec3 local(0.24 * rng.uniform(3 * i) - 0.12, 0.24 * rng.uniform(3 * i + 1) - 0.12,
+                     0.24 * rng.uniform(3 * i + 2) - 0.12);
+    const Vec3 p = pose.rotation * local + pose.position;
+    const auto a = analytic.nearest(p, 0.02);
+    const auto m = mesh.nearest(p, 0.02);
+    if (!a) {
+      EXPECT_FALSE(m.has_value()) << "point " << i << " is beyond the margin";
+      continue;
+    }
+    if (std::abs(a->distance) > 0.019) continue;  // deep inside: meshes see the surface only
+    ASSERT_TRUE(m.has_value()) << "point " << i;
+    EXPECT_NEAR(m->distance, a->distance, 1e-9) << "point " << i;
+    EXPECT_TRUE(m->point.isApprox(a->point, 1e-9)) << "point " << i;
+    ++compared;
+  }
+  EXPECT_GT(compared, 50);
+}
+
+TEST(Colliders, ClosestPointOnTriangleRegions) {
+  const Vec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  EXPECT_TRUE(closestPointOnTriangle(Vec3(0.2, 0.2, 1), a, b, c).isApprox(Vec3(0.2, 0.2, 0)));
+  EXPECT_TRUE(closestPointOnTriangle(Vec3(-1, -1, 0), a, b, c).isApprox(a));
+  EXPECT_TRUE(closestPointOnTriangle(Vec3(2, -1, 0), a, b, c).isApprox(b));
+  EXPECT_TRUE(closestPointOnTriangle(Vec3(0.5, -1, 0), a, b, c).isApprox(Vec3(0.5, 0, 0)));
+  EXPECT_TRUE(closestPointOnTriangle(Vec3(1, 1, 0), a, b, c).isApprox(Vec3(0.5, 0.5, 0)));
+}
+
+TEST(Colliders, RejectsDegenerateShapes) {
+  ColliderSet set;
+  EXPECT_THROW(set.add("b", box(Vec3(0.1, 0.0, 0.1)), at(Vec3::Zero())), std::invalid_argument);
+  EXPECT_THROW(set.add("s", sphere(-1.0), at(Vec3::Zero())), std::invalid_argument);
+  ColliderShape m = cubeMesh(0.1);
+  m.triangles.push_back({0, 1, 99});
+  EXPECT_THROW(set.add("m", m, at(Vec3::Zero())), std::invalid_argument);
+  EXPECT_THROW(set.add("p", ColliderShape{}, at(Vec3(std::nan(""), 0, 0))), std::invalid_argument);
+  EXPECT_EQ(set.size(), 0u);
+  EXPECT_THROW(set.setPose(0, at(Vec3::Zero())), std::out_of_range);
+}
+
+}  // namespace
+}  // namespace crumple::sim
