@@ -6,7 +6,9 @@
 #include <limits>
 
 #include "crumple/core/rng.hpp"
+#include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/sim/colliders.hpp"
+#include "crumple/sim/elastic_sheet.hpp"
 
 namespace crumple::sim {
 namespace {
@@ -132,6 +134,74 @@ TEST(Colliders, RejectsDegenerateShapes) {
   EXPECT_THROW(set.add("p", ColliderShape{}, at(Vec3(std::nan(""), 0, 0))), std::invalid_argument);
   EXPECT_EQ(set.size(), 0u);
   EXPECT_THROW(set.setPose(0, at(Vec3::Zero())), std::out_of_range);
+}
+
+// --- contacts in the elastic step (issue 5, item 2) -----------------------------
+
+// A 10 cm sheet lying flat at height y, front side up.
+mesh::SheetMesh flatSheet(double y, double maxEdge = 0.02) {
+  mesh::SheetMesh m = mesh::makeRectangleSheet(0.1, 0.1, maxEdge);
+  mesh::placePattern(m, Vec3(-0.05, y, 0.05), Vec3::UnitX(), -Vec3::UnitZ());
+  return m;
+}
+
+const PinFunction kNoPins = [](double, std::vector<Pin>& out) { out.clear(); };
+
+TEST(Contacts, ASheetDroppedOnATableComesToRestOnIt) {
+  const Material paper;
+  ElasticSheet sheet(flatSheet(0.02), paper, SimParams{});
+  ColliderSet table;
+  table.add("table", ColliderShape{}, at(Vec3::Zero()));
+  sheet.setColliders(&table, paper.thickness);
+  const double dt = 1.0 / 96.0;
+  double lowest = 1.0;
+  for (int step = 0; step < 96; ++step) {  // 1 s: falls 2 cm in ~64 ms, then rests
+    sheet.advance(step * dt, dt, kNoPins);
+    for (const Vec3& x : sheet.positions()) lowest = std::min(lowest, x.y());
+  }
+  EXPECT_GE(lowest, 0.9 * paper.thickness) << "no vertex deeper than 10 % of the thickness";
+  double highest = 0.0, speed = 0.0;
+  for (const Vec3& x : sheet.positions()) highest = std::max(highest, x.y());
+  for (const Vec3& v : sheet.velocities()) speed = std::max(speed, v.norm());
+  EXPECT_LT(highest, 2.0 * paper.thickness) << "it lies flat on the table";
+  EXPECT_LT(speed, 1e-3) << "at rest";
+  EXPECT_GT(sheet.contactVertexSteps(), 0);
+}
+
+TEST(Contacts, ASheetDrapesOverASphereWithoutEnteringIt) {
+  const Material paper;
+  ElasticSheet sheet(flatSheet(0.031, 0.01), paper, SimParams{});
+  ColliderSet ball;
+  ball.add("ball", sphere(0.03), at(Vec3::Zero()));
+  sheet.setColliders(&ball, paper.thickness);
+  const double dt = 1.0 / 384.0;
+  double nearest = 1.0;
+  for (int step = 0; step < 192; ++step) {  // 0.5 s
+    sheet.advance(step * dt, dt, kNoPins);
+    for (const Vec3& x : sheet.positions()) nearest = std::min(nearest, x.norm() - 0.03);
+  }
+  EXPECT_GE(nearest, 0.9 * paper.thickness);
+  // It rests on the ball (touching it) and bends around it: the edges droop.
+  double touch = 1.0, lowest = 1.0;
+  for (const Vec3& x : sheet.positions()) {
+    touch = std::min(touch, x.norm() - 0.03);
+    lowest = std::min(lowest, x.y());
+  }
+  EXPECT_LT(touch, 2.0 * paper.thickness);
+  EXPECT_LT(lowest, 0.031 - 0.002);
+}
+
+TEST(Contacts, WithoutCollidersTheSheetFallsThrough) {
+  const Material paper;
+  ElasticSheet sheet(flatSheet(0.02), paper, SimParams{});
+  ColliderSet table;
+  table.add("table", ColliderShape{}, at(Vec3::Zero()));
+  sheet.setColliders(&table, paper.thickness);
+  sheet.setColliders(nullptr, 0.0);  // switched off again
+  for (int step = 0; step < 48; ++step) sheet.advance(step / 96.0, 1.0 / 96.0, kNoPins);
+  EXPECT_LT(sheet.positions()[0].y(), -0.1);
+  EXPECT_EQ(sheet.contactVertexSteps(), 0);
+  EXPECT_THROW(sheet.setColliders(&table, 0.0), std::invalid_argument);
 }
 
 }  // namespace

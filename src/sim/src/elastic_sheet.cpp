@@ -49,6 +49,8 @@
 // too, a NumericalError is thrown with the state restored.
 #include "crumple/sim/elastic_sheet.hpp"
 
+#include "crumple/sim/colliders.hpp"
+
 #include <dlfcn.h>
 
 #include <Eigen/CholmodSupport>
@@ -132,6 +134,11 @@ using VecX = Eigen::VectorXd;
 // supernodes) beats the simplicial one (bench_sim, one substep, medians:
 // 96 triangles 0.37 vs 0.47 ms, 1 064 triangles 13.8 vs 13.9 ms, 10 080
 // triangles 413 vs 183 ms for simplicial vs supernodal).
+// Contact penalty stiffness in units of the vertex's mass / h^2: the gap
+// left by a force F is F h^2 / (kContactScale m), 1e-6 m for gravity at
+// h = 1/96 s (issue 5).
+constexpr double kContactScale = 100.0;
+
 constexpr int kSupernodalMinDofs = 3000;
 
 // OpenBLAS (Debian's libblas.so.3 with libopenblas0) threads its kernels;
@@ -206,6 +213,19 @@ struct ElasticSheet::Impl {
   std::vector<int> triOffset;    // 81 per triangle: value index or -1
   std::vector<int> hingeOffset;  // 144 per hinge
   std::vector<int> diagOffset;   // per free DOF
+  std::vector<int> vertexOffset;  // 9 per free vertex: its 3x3 diagonal block (lower part), or -1
+
+  // Contacts (issue 5): the colliders the free vertices must keep `contactDistance` from.
+  const ColliderSet* colliders = nullptr;
+  double contactDistance = 0.0;
+  // Per step: each vertex's frozen contact plane (point, outward normal), if any.
+  struct ContactPlane {
+    int vertex;
+    Vec3 point;
+    Vec3 normal;
+  };
+  std::vector<ContactPlane> contactPlanes;
+  long contactVertexSteps = 0;  // contacts found, summed over steps (statistics)
   Solver solver;
   int analyzeCount = 0;
   bool supernodal = false;  // which CHOLMOD factorisation the last analysis chose
@@ -421,6 +441,11 @@ bool ElasticSheet::Impl::buildSystem(const std::vector<int>& pinned) {
     offsets(hingeVertices[k].data(), 4, hingeOffset.data() + k * 144);
   diagOffset.resize(static_cast<std::size_t>(n));
   for (int d = 0; d < n; ++d) diagOffset[static_cast<std::size_t>(d)] = find(d, d);
+  vertexOffset.assign(static_cast<std::size_t>(freeCount) * 9, -1);
+  for (int f = 0; f < freeCount; ++f)
+    for (int c = 0; c < 3; ++c)
+      for (int r = c; r < 3; ++r)
+        vertexOffset[static_cast<std::size_t>(f * 9 + c * 3 + r)] = find(3 * f + r, 3 * f + c);
 
   pinnedSet = pinned;
   systemBuilt = true;
@@ -600,6 +625,37 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
   };
 
   const double massDiag = 1.0 / (h * h) + alpha / h;
+
+  // Contacts (issue 5; paper Sec. 4): a free vertex that may come within the
+  // contact distance D of a collider during the step gets the collider's
+  // tangent plane (point p, outward normal m) at the start of the step,
+  // frozen for the step, and the penalty k/2 max(0, D - m.(x - p))^2 with
+  // k = kContactScale * mass / h^2 (a stiff spring on the inertia's scale).
+  // A projection after the solve is the failsafe (contactFailsafe).
+  contactPlanes.clear();
+  std::vector<double> contactK;
+  if (colliders != nullptr && colliders->size() > 0) {
+    for (std::size_t i = 0; i < nv; ++i) {
+      if (freeIndex[i] < 0) continue;
+      const double reach = 2.0 * contactDistance + (xk[i] - xn[i]).norm();
+      if (const auto c = colliders->nearest(xn[i], reach)) {
+        contactPlanes.push_back({static_cast<int>(i), c->point, c->normal});
+        contactK.push_back(kContactScale * mass[i] / (h * h));
+      }
+    }
+    contactVertexSteps += static_cast<long>(contactPlanes.size());
+  }
+  // Penalty energy of the contacts at xs.
+  auto contactEnergy = [&](const std::vector<Vec3>& xs) {
+    double e = 0.0;
+    for (std::size_t c = 0; c < contactPlanes.size(); ++c) {
+      const auto& cp = contactPlanes[c];
+      const double gap =
+          contactDistance - cp.normal.dot(xs[static_cast<std::size_t>(cp.vertex)] - cp.point);
+      if (gap > 0.0) e += 0.5 * contactK[c] * gap * gap;
+    }
+    return e;
+  };
   static const bool debugNewton = [] {
     const char* e = std::getenv("CRUMPLE_DEBUG_NEWTON");
     return e != nullptr && e[0] == '1';
@@ -630,6 +686,12 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
     }
     scatterVectors(triangles, triGrad, freeIndex, 1.0, gradV);
     scatterVectors(hingeVertices, hingeGrad, freeIndex, 1.0, gradV);
+    for (std::size_t c = 0; c < contactPlanes.size(); ++c) {
+      const auto& cp = contactPlanes[c];
+      const auto vi = static_cast<std::size_t>(cp.vertex);
+      const double gap = contactDistance - cp.normal.dot(xk[vi] - cp.point);
+      if (gap > 0.0) gradV.segment<3>(3 * freeIndex[vi]) -= contactK[c] * gap * cp.normal;
+    }
     grad = gradQ + gradV;
     if (!grad.allFinite()) {
       why = "non-finite forces";
@@ -649,6 +711,15 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
       }
       scatterBlocks(triHess, beta > 0.0 ? &triDamp : nullptr, dampScale, triOffset, values);
       scatterBlocks(hingeHess, beta > 0.0 ? &hingeDamp : nullptr, dampScale, hingeOffset, values);
+      for (std::size_t c = 0; c < contactPlanes.size(); ++c) {
+        const auto& cp = contactPlanes[c];
+        const auto vi = static_cast<std::size_t>(cp.vertex);
+        if (contactDistance - cp.normal.dot(xk[vi] - cp.point) <= 0.0) continue;
+        const int* off = vertexOffset.data() + 9 * freeIndex[vi];
+        for (int col = 0; col < 3; ++col)
+          for (int row = col; row < 3; ++row)
+            values[off[col * 3 + row]] += contactK[c] * cp.normal[row] * cp.normal[col];
+      }
       return Eigen::Map<const VecX>(values, matrix.nonZeros()).allFinite();
     };
     if (!assemble()) {
@@ -718,6 +789,7 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
       curvature += kd.dot(dx);
     }
     const double slopeQ = gradQ.dot(dx);
+    const double contactNow = contactEnergy(xk);
     double s = 1.0;
     bool accepted = false;
     for (int ls = 0; ls <= kMaxLineSearchHalvings; ++ls, s *= 0.5) {
@@ -726,6 +798,7 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
       double deltaV = 0.0;
       for (std::size_t i = 0; i < triangles.size(); ++i) deltaV += triTrial[i] - triEnergy[i];
       for (std::size_t k = 0; k < hinges.size(); ++k) deltaV += hingeTrial[k] - hingeEnergy[k];
+      if (!contactPlanes.empty()) deltaV += contactEnergy(xTrial) - contactNow;
       const double deltaPhi = s * slopeQ + 0.5 * s * s * curvature + deltaV;
       if (std::isfinite(deltaPhi) && deltaPhi <= kArmijo * s * slope) {
         accepted = true;
@@ -771,10 +844,25 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
     why = "non-finite positions";
     return false;
   }
+  // Failsafe: a free vertex still nearer than D to a collider (a contact the
+  // frozen plane missed) is moved out along the collider's normal, and its
+  // velocity loses the part that points into the collider.
+  std::vector<std::pair<std::size_t, Vec3>> pushed;
+  if (colliders != nullptr && colliders->size() > 0) {
+    for (std::size_t i = 0; i < nv; ++i) {
+      if (freeIndex[i] < 0) continue;
+      if (const auto c = colliders->nearest(xk[i], contactDistance);
+          c && c->distance < contactDistance) {
+        xk[i] += (contactDistance - c->distance) * c->normal;
+        pushed.emplace_back(i, c->normal);
+      }
+    }
+  }
   for (std::size_t i = 0; i < nv; ++i) {
     v[i] = (xk[i] - xn[i]) / h;
     x[i] = xk[i];
   }
+  for (const auto& [i, m] : pushed) v[i] -= std::min(0.0, v[i].dot(m)) * m;
   trackBranches(x);
   return true;
 }
@@ -849,6 +937,15 @@ StepStats ElasticSheet::advance(double t, double dt, const PinFunction& pins) {
   }
   return stats;
 }
+
+void ElasticSheet::setColliders(const ColliderSet* colliders, double contactDistance) {
+  if (colliders != nullptr && !(contactDistance > 0.0 && std::isfinite(contactDistance)))
+    throw std::invalid_argument("ElasticSheet::setColliders: contact distance must be > 0");
+  impl_->colliders = colliders;
+  impl_->contactDistance = contactDistance;
+}
+
+long ElasticSheet::contactVertexSteps() const { return impl_->contactVertexSteps; }
 
 const std::vector<Vec3>& ElasticSheet::positions() const { return impl_->x; }
 const std::vector<Vec3>& ElasticSheet::velocities() const { return impl_->v; }

@@ -15,6 +15,8 @@
 
 namespace crumple::sim {
 
+class ColliderSet;
+
 struct SimParams {
   Vec3 gravity{0.0, -9.81, 0.0};  // m/s^2
   double massDamping = 0.5;       // 1/s  (Rayleigh alpha: force -alpha M v)
@@ -73,6 +75,17 @@ class ElasticSheet {
   // halves, down to params.maxHalvings; after that throws NumericalError
   // (stage "elastic") and leaves the state as it was before the call.
   StepStats advance(double t, double dt, const PinFunction& pins);
+
+  // Contacts (issue 5): free vertices keep `contactDistance` (m, > 0; the
+  // paper's thickness) from every collider of the set: a penalty on frozen
+  // tangent planes in the implicit step, then a projection failsafe, so that
+  // no free vertex ends a step nearer than contactDistance. The set is not
+  // owned and must outlive the sheet or the next call; the caller moves
+  // animated colliders before each advance(). nullptr switches contacts off
+  // (the default: a scene without colliders pays nothing).
+  void setColliders(const ColliderSet* colliders, double contactDistance);
+  // Vertex-steps with a contact plane since construction (statistics).
+  long contactVertexSteps() const;
 
   const std::vector<Vec3>& positions() const;
   const std::vector<Vec3>& velocities() const;
