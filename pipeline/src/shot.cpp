@@ -22,6 +22,7 @@
 #include "crumple/pipeline/handle_rig.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/render/osmesa_renderer.hpp"
+#include "crumple/sim/colliders.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
 #include "frame_output.hpp"
 #include "json_writer.hpp"
@@ -82,6 +83,65 @@ cache::CameraRecord cameraAt(const io::SceneSpec& scene, const io::AnimationScen
   rec.yfov = c.yfov;
   return rec;
 }
+
+// The scene's [[colliders]] as a sim::ColliderSet; mesh colliders move
+// rigidly with their nodes (moveTo). Empty when the scene has none.
+class SceneColliders {
+ public:
+  SceneColliders(const io::SceneSpec& scene, const io::AnimationScene* animation)
+      : scene_(scene), animation_(animation) {
+    for (const auto& c : scene.colliders) {
+      sim::ColliderShape shape;
+      Pose pose;
+      pose.position = c.position;
+      switch (c.kind) {
+        case io::ColliderSpec::Kind::Plane:
+          shape.kind = sim::ColliderShape::Kind::Plane;
+          pose.rotation = Quat::FromTwoVectors(Vec3::UnitY(), c.normal);
+          break;
+        case io::ColliderSpec::Kind::Box:
+          shape.kind = sim::ColliderShape::Kind::Box;
+          shape.halfExtents = 0.5 * c.size;
+          break;
+        case io::ColliderSpec::Kind::Sphere:
+          shape.kind = sim::ColliderShape::Kind::Sphere;
+          shape.radius = c.radius;
+          break;
+        case io::ColliderSpec::Kind::Mesh: {
+          // The node's mesh in world space at t = 0 is the rest shape.
+          const auto m = animation->mesh(c.node);
+          shape.kind = sim::ColliderShape::Kind::Mesh;
+          shape.vertices = m->vertices;
+          shape.triangles = m->triangles;
+          pose = Pose{};
+          break;
+        }
+      }
+      set_.add(c.name, std::move(shape), pose);
+    }
+  }
+  bool empty() const { return set_.size() == 0; }
+  const sim::ColliderSet& set() const { return set_; }
+
+  // Mesh colliders to time t: the node's rigid motion since t = 0.
+  void moveTo(double t) {
+    for (std::size_t i = 0; i < scene_.colliders.size(); ++i) {
+      const auto& c = scene_.colliders[i];
+      if (c.node.empty()) continue;
+      const Pose p0 = animation_->worldPose(c.node, 0.0);
+      const Pose pt = animation_->worldPose(c.node, t);
+      Pose motion;
+      motion.rotation = pt.rotation * p0.rotation.conjugate();
+      motion.position = pt.position - motion.rotation * p0.position;
+      set_.setPose(static_cast<int>(i), motion);
+    }
+  }
+
+ private:
+  const io::SceneSpec& scene_;
+  const io::AnimationScene* animation_;
+  sim::ColliderSet set_;
+};
 
 // After the frames: the contact sheet (DIR/contact_sheet.png) and the movie
 // (DIR/preview.mp4, with DIR/sound.wav when there is one), DIR being the
@@ -271,6 +331,11 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   }
   const double t0 = frameTime(scene, scene.frameStart);
   const bool hybridModel = scene.model.type == io::ModelSpec::Type::Hybrid;
+  if (hybridModel && !scene.colliders.empty())
+    throw InputError(
+        scene.file,
+        "'colliders': contacts are simulated with the elastic model only so far; the "
+        "crumpling model ([model] type = \"hybrid\") does not take them yet (issue 5)");
   sim::SimParams params;
   params.gravity = scene.sim.gravity;
   params.massDamping = scene.sim.massDamping;
@@ -322,6 +387,8 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
 
   std::optional<sim::ElasticSheet> elastic;
   if (!hybrid) elastic.emplace(sheet, materialOf(scene.paper), params);
+  SceneColliders colliders(scene, animation.get());
+  if (elastic && !colliders.empty()) elastic->setColliders(&colliders.set(), scene.paper.thickness);
 
   cache::CacheHeader header;
   header.fps = scene.fps;
@@ -448,9 +515,11 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
         // Substep s of frame f starts at ((f - 1) * substeps + s) * dt.
         const double t = static_cast<double>((frame - 1) * scene.substeps + s) * dt;
         try {
+          if (!colliders.empty()) colliders.moveTo(t + dt);
           const auto stats = elastic->advance(t, dt, pins);
           report.newtonIterations += stats.newtonIterations;
           report.halvings += stats.halvings;
+          report.contactMs += stats.contactMs;
           ++report.substeps;
         } catch (const NumericalError& e) {
           throw NumericalError(e.stage(), frame, e.problem());
@@ -561,6 +630,13 @@ std::string summaryText(const ShotReport& r) {
                 r.substeps > 0 ? static_cast<double>(r.newtonIterations) / r.substeps : 0.0,
                 r.halvings, r.maxHandleError, r.maxStrain);
   out += line;
+  if (r.contactMs > 0.0 && r.stages.count("elastic") && r.stages.at("elastic").frames > 0) {
+    const auto& e = r.stages.at("elastic");
+    std::snprintf(line, sizeof line, "  contacts %.2f ms/frame (%.0f %% of the elastic step)\n",
+                  r.contactMs / static_cast<double>(e.frames),
+                  e.totalMs > 0.0 ? 100.0 * r.contactMs / e.totalMs : 0.0);
+    out += line;
+  }
   out += "  cache:   " + r.cachePath + "\n";
   if (!r.framesDir.empty()) out += "  frames:  " + r.framesDir + "/\n";
   if (!r.contactSheetPath.empty()) out += "  contact sheet: " + r.contactSheetPath + "\n";
@@ -595,7 +671,7 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
   j.key("ran").beginObject();
   j.key("elastic").value(true);
   j.key("crumpling_model").value(r.hybrid);
-  j.key("contacts").value(false);
+  j.key("contacts").value(!scene.colliders.empty());
   j.key("self_contact").value(false);
   j.key("tearing").value(false);
   j.key("sound").value(false);
@@ -605,6 +681,14 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
   j.key("ms_per_frame").beginObject();
   for (const auto& [name, cost] : r.stages) j.key(name).value(cost.msPerFrame());
   j.endObject();
+  if (!scene.colliders.empty()) {
+    // Contact detection and the failsafe, part of the elastic stage's time.
+    const long frames = r.stages.count("elastic") ? r.stages.at("elastic").frames : 0;
+    const double elasticMs = r.stages.count("elastic") ? r.stages.at("elastic").totalMs : 0.0;
+    j.key("contact_ms_per_frame")
+        .value(frames > 0 ? r.contactMs / static_cast<double>(frames) : 0.0);
+    j.key("contact_share_of_elastic").value(elasticMs > 0.0 ? r.contactMs / elasticMs : 0.0);
+  }
   j.key("newton_iterations").value(static_cast<long long>(r.newtonIterations));
   j.key("substep_halvings").value(static_cast<long long>(r.halvings));
   j.key("max_handle_error").value(r.maxHandleError);

@@ -761,3 +761,43 @@ TEST(SceneRendering, BadRenderingKeysNameTheirLine) {
 
 }  // namespace
 }  // namespace crumple::io
+
+namespace crumple::io {
+namespace {
+
+TEST(SceneColliders, ShapesAndErrors) {
+  const SceneSpec s = parse("[scene]\nunits = \"cm\"\n" + kSheet + R"(
+[[colliders]]
+type = "plane"
+normal = [0, 2, 0]
+position = [0, 5, 0]
+[[colliders]]
+name = "crate"
+type = "box"
+size = [10, 20, 30]
+[[colliders]]
+type = "sphere"
+radius = 4
+)");
+  ASSERT_EQ(s.colliders.size(), 3u);
+  EXPECT_EQ(s.colliders[0].kind, ColliderSpec::Kind::Plane);
+  EXPECT_EQ(s.colliders[0].name, "collider0");
+  EXPECT_TRUE(s.colliders[0].normal.isApprox(Vec3::UnitY()));
+  EXPECT_TRUE(s.colliders[0].position.isApprox(Vec3(0, 0.05, 0)));
+  EXPECT_TRUE(s.colliders[1].size.isApprox(Vec3(0.1, 0.2, 0.3)));
+  EXPECT_NEAR(s.colliders[2].radius, 0.04, 1e-15);
+  expectError(kSheet + "[[colliders]]\nposition = [0, 0, 0]\n", 4, "colliders[0].type",
+              {"missing"});
+  expectError(kSheet + "[[colliders]]\ntype = \"cone\"\n", 5, "colliders[0].type", {"sphere"});
+  expectError(kSheet + "[[colliders]]\ntype = \"sphere\"\nradius = 0\n", 6, "colliders[0].radius");
+  expectError(kSheet + "[[colliders]]\ntype = \"box\"\nsize = [1, 1, 1]\nradius = 2\n", 7,
+              "colliders[0].radius", {"only for spheres"});
+  expectError(kSheet + "[[colliders]]\ntype = \"mesh\"\nnode = \"Table\"\n", 6, "colliders[0].node",
+              {"animation file"});
+  expectError(kSheet + "[[colliders]]\ntype = \"plane\"\n[[colliders]]\ntype = \"plane\"\n" +
+                  "name = \"collider0\"\n",
+              8, "colliders[1].name", {"duplicate"});
+}
+
+}  // namespace
+}  // namespace crumple::io

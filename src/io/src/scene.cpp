@@ -46,7 +46,7 @@ class SceneParser {
   SceneSpec parse() {
     const TableReader root(root_, "", file_);
     root.allowOnly({"scene", "sheet", "paper", "handles", "camera", "lights", "environment",
-                    "ground", "props", "output", "sim", "model"});
+                    "ground", "props", "colliders", "output", "sim", "model"});
     // [scene] first: its `units` scales every length that follows.
     parseScene(root.subTable("scene"));
     const toml::table* sheet = root.subTable("sheet");
@@ -59,6 +59,7 @@ class SceneParser {
     parseEnvironment(root.subTable("environment"));
     parseGround(root.subTable("ground"));
     parseProps(root);
+    parseColliders(root);
     parseOutput(root.subTable("output"));
     parseSim(root.subTable("sim"));
     parseModel(root.subTable("model"));
@@ -492,6 +493,68 @@ class SceneParser {
     }
   }
 
+  void parseColliders(const TableReader& root) {
+    const toml::array* colliders = root.tableArray("colliders");
+    if (!colliders) return;
+    std::set<std::string> names;
+    for (std::size_t i = 0; i < colliders->size(); ++i) {
+      const TableReader r(*colliders->get(i)->as_table(), "colliders[" + std::to_string(i) + "]",
+                          file_);
+      r.allowOnly({"name", "type", "position", "normal", "size", "radius", "node"});
+      ColliderSpec c;
+      const std::optional<std::string> type = r.string("type");
+      if (!type) r.missing("type");
+      const auto only = [&](const char* key, const char* types) {
+        if (r.has(key)) r.fail(key, std::string("only for ") + types);
+      };
+      if (auto p = r.vec3("position")) c.position = *p * mpu();
+      if (*type == "plane") {
+        c.kind = ColliderSpec::Kind::Plane;
+        if (auto n = r.vec3("normal")) c.normal = r.requireDirection("normal", *n);
+        only("size", "boxes");
+        only("radius", "spheres");
+        only("node", "meshes");
+      } else if (*type == "box") {
+        c.kind = ColliderSpec::Kind::Box;
+        const std::optional<Vec3> sz = r.vec3("size");
+        if (!sz) r.missing("size");
+        if (!(sz->minCoeff() > 0.0)) r.fail("size", "every side must be > 0");
+        c.size = *sz * mpu();
+        only("normal", "planes");
+        only("radius", "spheres");
+        only("node", "meshes");
+      } else if (*type == "sphere") {
+        c.kind = ColliderSpec::Kind::Sphere;
+        const std::optional<double> rad = r.number("radius");
+        if (!rad) r.missing("radius");
+        c.radius = r.requirePositive("radius", *rad) * mpu();
+        only("normal", "planes");
+        only("size", "boxes");
+        only("node", "meshes");
+      } else if (*type == "mesh") {
+        c.kind = ColliderSpec::Kind::Mesh;
+        const std::optional<std::string> node = r.string("node");
+        if (!node) r.missing("node");
+        if (node->empty()) r.fail("node", "must not be empty");
+        if (spec_.animationFile.empty())
+          r.fail("node", "a mesh collider needs an animation file ([scene] animation)");
+        c.node = *node;
+        c.nodeLine = r.lineOf("node");
+        only("position", "planes, boxes and spheres (a mesh moves with its node)");
+        only("normal", "planes");
+        only("size", "boxes");
+        only("radius", "spheres");
+      } else {
+        r.fail("type",
+               "unknown collider type '" + *type + "' (expected plane, box, sphere or mesh)");
+      }
+      c.name = r.string("name").value_or(c.node.empty() ? "collider" + std::to_string(i) : c.node);
+      if (c.name.empty()) r.fail("name", "must not be empty");
+      if (!names.insert(c.name).second) r.fail("name", "duplicate collider name '" + c.name + "'");
+      spec_.colliders.push_back(std::move(c));
+    }
+  }
+
   void parseGround(const toml::table* table) {
     if (!table) return;
     const TableReader r(*table, "ground", file_);
@@ -692,6 +755,15 @@ void checkAnimationNodes(const SceneSpec& scene, const AnimationScene& animation
         throw InputError(animation.file(),
                          "node '" + scene.sheet.patternMesh + "' holds no triangle mesh");
       }
+    });
+  }
+  for (std::size_t i = 0; i < scene.colliders.size(); ++i) {
+    const ColliderSpec& c = scene.colliders[i];
+    if (c.node.empty()) continue;
+    check(c.nodeLine, "colliders[" + std::to_string(i) + "].node", [&] {
+      const std::optional<ImportedMesh> m = animation.mesh(c.node);
+      if (!m || m->triangles.empty())
+        throw InputError(animation.file(), "node '" + c.node + "' holds no triangle mesh");
     });
   }
   for (std::size_t i = 0; i < scene.props.size(); ++i) {

@@ -49,13 +49,12 @@
 // too, a NumericalError is thrown with the state restored.
 #include "crumple/sim/elastic_sheet.hpp"
 
-#include "crumple/sim/colliders.hpp"
-
 #include <dlfcn.h>
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCore>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -68,6 +67,7 @@
 
 #include "crumple/core/error.hpp"
 #include "crumple/core/parallel.hpp"
+#include "crumple/sim/colliders.hpp"
 #include "crumple/sim/energies.hpp"
 
 namespace crumple::sim {
@@ -209,10 +209,10 @@ struct ElasticSheet::Impl {
   std::vector<int> pinnedSet;  // sorted pinned vertices of the current pattern
   std::vector<int> freeIndex;  // vertex -> free block index, -1 if pinned/inactive
   int freeCount = 0;
-  SpMat matrix;                  // lower triangle, 3 x 3 blocks
-  std::vector<int> triOffset;    // 81 per triangle: value index or -1
-  std::vector<int> hingeOffset;  // 144 per hinge
-  std::vector<int> diagOffset;   // per free DOF
+  SpMat matrix;                   // lower triangle, 3 x 3 blocks
+  std::vector<int> triOffset;     // 81 per triangle: value index or -1
+  std::vector<int> hingeOffset;   // 144 per hinge
+  std::vector<int> diagOffset;    // per free DOF
   std::vector<int> vertexOffset;  // 9 per free vertex: its 3x3 diagonal block (lower part), or -1
 
   // Contacts (issue 5): the colliders the free vertices must keep `contactDistance` from.
@@ -634,6 +634,7 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
   // A projection after the solve is the failsafe (contactFailsafe).
   contactPlanes.clear();
   std::vector<double> contactK;
+  const auto contactStart = std::chrono::steady_clock::now();
   if (colliders != nullptr && colliders->size() > 0) {
     for (std::size_t i = 0; i < nv; ++i) {
       if (freeIndex[i] < 0) continue;
@@ -644,6 +645,9 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
       }
     }
     contactVertexSteps += static_cast<long>(contactPlanes.size());
+    stats.contactMs +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - contactStart)
+            .count();
   }
   // Penalty energy of the contacts at xs.
   auto contactEnergy = [&](const std::vector<Vec3>& xs) {
@@ -849,6 +853,7 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
   // velocity loses the part that points into the collider.
   std::vector<std::pair<std::size_t, Vec3>> pushed;
   if (colliders != nullptr && colliders->size() > 0) {
+    const auto failsafeStart = std::chrono::steady_clock::now();
     for (std::size_t i = 0; i < nv; ++i) {
       if (freeIndex[i] < 0) continue;
       if (const auto c = colliders->nearest(xk[i], contactDistance);
@@ -857,6 +862,9 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
         pushed.emplace_back(i, c->normal);
       }
     }
+    stats.contactMs +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - failsafeStart)
+            .count();
   }
   for (std::size_t i = 0; i < nv; ++i) {
     v[i] = (xk[i] - xn[i]) / h;

@@ -67,7 +67,9 @@ struct ShotReport {
   long newtonIterations = 0;
   long substeps = 0;
   long halvings = 0;
-  long elasticRetries = 0;  // hybrid: elastic steps retried with the pins on their targets
+  long elasticRetries = 0;
+  double contactMs = 0.0;  // contact detection and failsafe, within the elastic stage  // hybrid:
+                           // elastic steps retried with the pins on their targets
   std::size_t vertices = 0;
   std::size_t triangles = 0;
   double maxHandleError = 0.0;

@@ -115,6 +115,22 @@ struct PropSpec {
   Vec3 color{0.6, 0.6, 0.6};
 };
 
+// A collider the sheet must stay outside of (issue 5). Plane: the solid half
+// below `position` along -normal; box: axis-aligned, centred on `position`;
+// sphere: centred on `position`; mesh: the triangles of an animation-file
+// node, moving with the node.
+struct ColliderSpec {
+  enum class Kind { Plane, Box, Sphere, Mesh };
+  std::string name;
+  Kind kind = Kind::Plane;
+  Vec3 position = Vec3::Zero();     // m
+  Vec3 normal = Vec3::UnitY();      // plane (unit)
+  Vec3 size = Vec3::Constant(0.1);  // m, box side lengths
+  double radius = 0.05;             // m, sphere
+  std::string node;                 // mesh
+  long nodeLine = 0;
+};
+
 struct GroundSpec {
   bool enabled = false;
   double height = 0.0;  // m, world Y of the plane
@@ -184,6 +200,7 @@ struct SceneSpec {
   GroundSpec ground;
   PaperLookSpec look;  // [paper] texture, texture_size, transmittance, crease_deg
   std::vector<PropSpec> props;
+  std::vector<ColliderSpec> colliders;  // [[colliders]]: contacts run only when there are some
   OutputSpec output;
   SimSpec sim;
   ModelSpec model;

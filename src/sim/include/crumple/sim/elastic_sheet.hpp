@@ -52,6 +52,7 @@ struct StepStats {
   int halvings = 0;          // how many times a step was split
   int solves = 0;            // Cholesky factorisations
   double finalStepNorm = 0.0;
+  double contactMs = 0.0;  // wall time of contact detection and the failsafe (timing only)
 };
 
 class ElasticSheet {
