@@ -117,7 +117,7 @@ class SceneColliders {
           break;
         }
       }
-      set_.add(c.name, std::move(shape), pose);
+      set_.add(c.name, std::move(shape), pose, c.friction);
     }
   }
   bool empty() const { return set_.size() == 0; }

@@ -778,6 +778,7 @@ size = [10, 20, 30]
 [[colliders]]
 type = "sphere"
 radius = 4
+friction = 0.5
 )");
   ASSERT_EQ(s.colliders.size(), 3u);
   EXPECT_EQ(s.colliders[0].kind, ColliderSpec::Kind::Plane);
@@ -786,6 +787,8 @@ radius = 4
   EXPECT_TRUE(s.colliders[0].position.isApprox(Vec3(0, 0.05, 0)));
   EXPECT_TRUE(s.colliders[1].size.isApprox(Vec3(0.1, 0.2, 0.3)));
   EXPECT_NEAR(s.colliders[2].radius, 0.04, 1e-15);
+  EXPECT_DOUBLE_EQ(s.colliders[0].friction, 0.3);
+  EXPECT_DOUBLE_EQ(s.colliders[2].friction, 0.5);
   expectError(kSheet + "[[colliders]]\nposition = [0, 0, 0]\n", 4, "colliders[0].type",
               {"missing"});
   expectError(kSheet + "[[colliders]]\ntype = \"cone\"\n", 5, "colliders[0].type", {"sphere"});

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <limits>
 
 #include "crumple/core/rng.hpp"
@@ -202,6 +203,48 @@ TEST(Contacts, WithoutCollidersTheSheetFallsThrough) {
   EXPECT_LT(sheet.positions()[0].y(), -0.1);
   EXPECT_EQ(sheet.contactVertexSteps(), 0);
   EXPECT_THROW(sheet.setColliders(&table, 0.0), std::invalid_argument);
+}
+
+// The centroid's travel over `seconds` of a sheet resting on a plane tilted
+// by `slope` (rad) with friction `mu` (paper on it).
+double slideOnSlope(double slope, double mu, double seconds) {
+  const Material paper;
+  const Quat tilt(Eigen::AngleAxisd(slope, Vec3::UnitZ()));
+  mesh::SheetMesh m = flatSheet(paper.thickness);
+  for (Vec3& x : m.positions) x = tilt * x;
+  ElasticSheet sheet(m, paper, SimParams{});
+  ColliderSet slopeSet;
+  slopeSet.add("slope", ColliderShape{}, at(Vec3::Zero(), tilt), mu);
+  sheet.setColliders(&slopeSet, paper.thickness);
+  const auto centroid = [&] {
+    Vec3 c = Vec3::Zero();
+    for (const Vec3& x : sheet.positions()) c += x;
+    return Vec3(c / static_cast<double>(sheet.positions().size()));
+  };
+  const Vec3 start = centroid();
+  const double dt = 1.0 / 96.0;
+  double lowest = 1.0;
+  for (int step = 0; step < static_cast<int>(seconds * 96.0); ++step) {
+    sheet.advance(step * dt, dt, kNoPins);
+    for (const Vec3& x : sheet.positions()) lowest = std::min(lowest, (tilt.conjugate() * x).y());
+  }
+  EXPECT_GE(lowest, 0.9 * paper.thickness) << "slope " << slope;
+  return (centroid() - start).norm();
+}
+
+TEST(Contacts, FrictionHoldsASheetOnA10DegreeSlopeAndLetsItSlideOn30) {
+  constexpr double kDeg = 3.14159265358979323846 / 180.0;
+  const double held = slideOnSlope(10.0 * kDeg, 0.3, 1.0);
+  const double slid = slideOnSlope(30.0 * kDeg, 0.3, 1.0);
+  const double frictionless = slideOnSlope(10.0 * kDeg, 0.0, 1.0);
+  std::cout << "[ measure ] travel in 1 s, mu 0.3: 10 deg " << held << " m, 30 deg " << slid
+            << " m; mu 0, 10 deg: " << frictionless << " m\n";
+  EXPECT_LT(held, 2e-3) << "tan 10 deg = 0.18 < 0.3: it stays";
+  // Sliding with a = g (sin 30 - 0.3 cos 30) = 2.36 m/s^2: about 1.2 m in 1 s.
+  EXPECT_GT(slid, 0.5);
+  EXPECT_LT(slid, 1.6);
+  // Without friction even 10 degrees slides: g sin 10 = 1.7 m/s^2.
+  EXPECT_GT(frictionless, 0.4);
 }
 
 }  // namespace

@@ -500,7 +500,7 @@ class SceneParser {
     for (std::size_t i = 0; i < colliders->size(); ++i) {
       const TableReader r(*colliders->get(i)->as_table(), "colliders[" + std::to_string(i) + "]",
                           file_);
-      r.allowOnly({"name", "type", "position", "normal", "size", "radius", "node"});
+      r.allowOnly({"name", "type", "position", "normal", "size", "radius", "node", "friction"});
       ColliderSpec c;
       const std::optional<std::string> type = r.string("type");
       if (!type) r.missing("type");
@@ -548,6 +548,7 @@ class SceneParser {
         r.fail("type",
                "unknown collider type '" + *type + "' (expected plane, box, sphere or mesh)");
       }
+      if (auto mu = r.number("friction")) c.friction = r.requireNonNegative("friction", *mu);
       c.name = r.string("name").value_or(c.node.empty() ? "collider" + std::to_string(i) : c.node);
       if (c.name.empty()) r.fail("name", "must not be empty");
       if (!names.insert(c.name).second) r.fail("name", "duplicate collider name '" + c.name + "'");

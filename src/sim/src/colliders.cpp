@@ -82,6 +82,7 @@ struct ColliderSet::Impl {
     std::string name;
     ColliderShape shape;
     Pose pose;
+    double friction = 0.0;
     std::shared_ptr<BvhModel> bvh;  // meshes only
   };
   std::vector<Collider> colliders;
@@ -123,10 +124,11 @@ ColliderSet::~ColliderSet() = default;
 ColliderSet::ColliderSet(ColliderSet&&) noexcept = default;
 ColliderSet& ColliderSet::operator=(ColliderSet&&) noexcept = default;
 
-int ColliderSet::add(std::string name, ColliderShape shape, const Pose& pose) {
+int ColliderSet::add(std::string name, ColliderShape shape, const Pose& pose, double friction) {
   const auto bad = [&](const std::string& what) {
     throw std::invalid_argument("collider '" + name + "': " + what);
   };
+  if (!(friction >= 0.0) || !std::isfinite(friction)) bad("friction must be finite and >= 0");
   if (!pose.position.allFinite() || !pose.rotation.coeffs().allFinite() ||
       !(pose.rotation.norm() > 0.0))
     bad("pose is not finite");
@@ -162,6 +164,7 @@ int ColliderSet::add(std::string name, ColliderShape shape, const Pose& pose) {
     }
   }
   c.name = std::move(name);
+  c.friction = friction;
   c.shape = std::move(shape);
   c.pose = pose;
   c.pose.rotation.normalize();
@@ -181,6 +184,10 @@ void ColliderSet::setPose(int collider, const Pose& pose) {
 }
 
 std::size_t ColliderSet::size() const { return impl_->colliders.size(); }
+
+double ColliderSet::friction(int collider) const {
+  return impl_->colliders.at(static_cast<std::size_t>(collider)).friction;
+}
 
 const std::string& ColliderSet::name(int collider) const {
   return impl_->colliders.at(static_cast<std::size_t>(collider)).name;

@@ -136,8 +136,15 @@ using VecX = Eigen::VectorXd;
 // triangles 413 vs 183 ms for simplicial vs supernodal).
 // Contact penalty stiffness in units of the vertex's mass / h^2: the gap
 // left by a force F is F h^2 / (kContactScale m), 1e-6 m for gravity at
-// h = 1/96 s (issue 5).
-constexpr double kContactScale = 100.0;
+// h = 1/96 s, about 1 % of a sheet's thickness (issue 5).
+constexpr double kContactScale = 1000.0;
+// The failsafe projection acts on vertices the penalty left more than this
+// fraction of the contact distance too near (a penalty equilibrium is left
+// alone: its gap carries the normal force that friction needs).
+constexpr double kFailsafeSlack = 0.05;
+// Below this tangential speed (m/s) friction acts as a stiff spring (static
+// friction, smoothed); above it, as Coulomb's constant force.
+constexpr double kFrictionSpeed = 1e-3;
 
 constexpr int kSupernodalMinDofs = 3000;
 
@@ -223,6 +230,8 @@ struct ElasticSheet::Impl {
     int vertex;
     Vec3 point;
     Vec3 normal;
+    double mu;      // Coulomb friction coefficient
+    double lambda;  // lagged normal force (N) at the start of the step
   };
   std::vector<ContactPlane> contactPlanes;
   long contactVertexSteps = 0;  // contacts found, summed over steps (statistics)
@@ -640,8 +649,12 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
       if (freeIndex[i] < 0) continue;
       const double reach = 2.0 * contactDistance + (xk[i] - xn[i]).norm();
       if (const auto c = colliders->nearest(xn[i], reach)) {
-        contactPlanes.push_back({static_cast<int>(i), c->point, c->normal});
-        contactK.push_back(kContactScale * mass[i] / (h * h));
+        const double k = kContactScale * mass[i] / (h * h);
+        // The normal force the penalty exerted at x_n, lagged for friction.
+        const double lambda = k * std::max(0.0, contactDistance - c->distance);
+        contactPlanes.push_back(
+            {static_cast<int>(i), c->point, c->normal, colliders->friction(c->collider), lambda});
+        contactK.push_back(k);
       }
     }
     contactVertexSteps += static_cast<long>(contactPlanes.size());
@@ -649,14 +662,45 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - contactStart)
             .count();
   }
-  // Penalty energy of the contacts at xs.
+  // Coulomb friction with the lagged normal force (IPC's smoothed friction
+  // potential, Li et al. 2020, Sec. 5): the tangential displacement over the
+  // step u = T (x - x_n) costs mu lambda f0(|u|), where f0 is |u| beyond
+  // eps = kFrictionSpeed h and a cubic below it (static friction as a stiff,
+  // capped spring). frictionTerms gives the energy, and the gradient and
+  // (PSD) Hessian block of one contact.
+  const double eps = kFrictionSpeed * h;
+  auto frictionTerms = [&](const ContactPlane& cp, const Vec3& xi, const Vec3& xni, Vec3* grad,
+                           Mat3* hess) {
+    if (!(cp.mu > 0.0) || !(cp.lambda > 0.0)) return 0.0;
+    const Mat3 t = Mat3::Identity() - cp.normal * cp.normal.transpose();
+    const Vec3 u = t * (xi - xni);
+    const double y = u.norm();
+    const double scale = cp.mu * cp.lambda;
+    const double f0 = y >= eps ? y : -y * y * y / (3.0 * eps * eps) + y * y / eps + eps / 3.0;
+    if (grad != nullptr) {
+      const double f1OverY = y >= eps ? 1.0 / y : -y / (eps * eps) + 2.0 / eps;
+      const double f1Prime = y >= eps ? 0.0 : -2.0 * y / (eps * eps) + 2.0 / eps;
+      *grad = scale * f1OverY * u;
+      if (hess != nullptr) {
+        Mat3 inner = f1OverY * Mat3::Identity();
+        if (y > 1e-300) {
+          const Vec3 d = u / y;
+          inner += (f1Prime - f1OverY) * d * d.transpose();
+        }
+        *hess = scale * t * inner * t;
+      }
+    }
+    return scale * f0;
+  };
+  // Penalty and friction energy of the contacts at xs.
   auto contactEnergy = [&](const std::vector<Vec3>& xs) {
     double e = 0.0;
     for (std::size_t c = 0; c < contactPlanes.size(); ++c) {
       const auto& cp = contactPlanes[c];
-      const double gap =
-          contactDistance - cp.normal.dot(xs[static_cast<std::size_t>(cp.vertex)] - cp.point);
+      const auto vi = static_cast<std::size_t>(cp.vertex);
+      const double gap = contactDistance - cp.normal.dot(xs[vi] - cp.point);
       if (gap > 0.0) e += 0.5 * contactK[c] * gap * gap;
+      e += frictionTerms(cp, xs[vi], xn[vi], nullptr, nullptr);
     }
     return e;
   };
@@ -695,6 +739,9 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
       const auto vi = static_cast<std::size_t>(cp.vertex);
       const double gap = contactDistance - cp.normal.dot(xk[vi] - cp.point);
       if (gap > 0.0) gradV.segment<3>(3 * freeIndex[vi]) -= contactK[c] * gap * cp.normal;
+      Vec3 g = Vec3::Zero();
+      frictionTerms(cp, xk[vi], xn[vi], &g, nullptr);
+      gradV.segment<3>(3 * freeIndex[vi]) += g;
     }
     grad = gradQ + gradV;
     if (!grad.allFinite()) {
@@ -718,11 +765,16 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
       for (std::size_t c = 0; c < contactPlanes.size(); ++c) {
         const auto& cp = contactPlanes[c];
         const auto vi = static_cast<std::size_t>(cp.vertex);
-        if (contactDistance - cp.normal.dot(xk[vi] - cp.point) <= 0.0) continue;
+        Mat3 block = Mat3::Zero();
+        if (contactDistance - cp.normal.dot(xk[vi] - cp.point) > 0.0)
+          block += contactK[c] * cp.normal * cp.normal.transpose();
+        Vec3 g;
+        Mat3 hf = Mat3::Zero();
+        frictionTerms(cp, xk[vi], xn[vi], &g, &hf);
+        block += hf;
         const int* off = vertexOffset.data() + 9 * freeIndex[vi];
         for (int col = 0; col < 3; ++col)
-          for (int row = col; row < 3; ++row)
-            values[off[col * 3 + row]] += contactK[c] * cp.normal[row] * cp.normal[col];
+          for (int row = col; row < 3; ++row) values[off[col * 3 + row]] += block(row, col);
       }
       return Eigen::Map<const VecX>(values, matrix.nonZeros()).allFinite();
     };
@@ -848,16 +900,16 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
     why = "non-finite positions";
     return false;
   }
-  // Failsafe: a free vertex still nearer than D to a collider (a contact the
-  // frozen plane missed) is moved out along the collider's normal, and its
-  // velocity loses the part that points into the collider.
+  // Failsafe: a free vertex still nearer than (1 - slack) D to a collider (a
+  // contact the frozen plane missed) is moved out to D along the collider's
+  // normal, and its velocity loses the part that points into the collider.
   std::vector<std::pair<std::size_t, Vec3>> pushed;
   if (colliders != nullptr && colliders->size() > 0) {
     const auto failsafeStart = std::chrono::steady_clock::now();
     for (std::size_t i = 0; i < nv; ++i) {
       if (freeIndex[i] < 0) continue;
       if (const auto c = colliders->nearest(xk[i], contactDistance);
-          c && c->distance < contactDistance) {
+          c && c->distance < (1.0 - kFailsafeSlack) * contactDistance) {
         xk[i] += (contactDistance - c->distance) * c->normal;
         pushed.emplace_back(i, c->normal);
       }

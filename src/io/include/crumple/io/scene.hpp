@@ -127,6 +127,7 @@ struct ColliderSpec {
   Vec3 normal = Vec3::UnitY();      // plane (unit)
   Vec3 size = Vec3::Constant(0.1);  // m, box side lengths
   double radius = 0.05;             // m, sphere
+  double friction = 0.3;            // Coulomb coefficient of paper on this collider
   std::string node;                 // mesh
   long nodeLine = 0;
 };

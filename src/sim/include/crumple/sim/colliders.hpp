@@ -45,10 +45,12 @@ class ColliderSet {
   ColliderSet(ColliderSet&&) noexcept;
   ColliderSet& operator=(ColliderSet&&) noexcept;
 
-  // Adds a collider and returns its index. Throws std::invalid_argument for a
+  // Adds a collider and returns its index; `friction` is the Coulomb
+  // coefficient of paper on it (>= 0). Throws std::invalid_argument for a
   // non-finite or degenerate shape (box extents or radius <= 0, a mesh
-  // without triangles or with indices out of range).
-  int add(std::string name, ColliderShape shape, const Pose& pose);
+  // without triangles or with indices out of range) or a negative friction.
+  int add(std::string name, ColliderShape shape, const Pose& pose, double friction = 0.0);
+  double friction(int collider) const;
   // Moves an (animated) collider; its BVH is kept, only the pose changes.
   void setPose(int collider, const Pose& pose);
   std::size_t size() const;
