@@ -5,8 +5,11 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <utility>
 
+#include "crumple/core/error.hpp"
+#include "crumple/exporters/pcache_contacts.hpp"
 #include "json_writer.hpp"
 
 namespace crumple::pipeline {
@@ -66,8 +69,40 @@ FrameMetrics measureFrame(const cache::FrameRecord& frame) {
   m.singularVertices = frame.singularVertices.size();
   m.junctionVertices = frame.junctionVertices.size();
   m.tears = frame.tearCount;
+  std::optional<std::vector<cache::ContactRecord>> contacts;
+  try {
+    contacts = cache::decodeContacts(frame.extensions);
+  } catch (const CorruptDataError& e) {
+    throw CorruptDataError("frame " + std::to_string(frame.frame) + ": " + e.what());
+  }
+  if (contacts) {
+    m.contacts = contacts->size();
+    for (const auto& c : *contacts)
+      m.maxSlideSpeed = std::max(m.maxSlideSpeed, static_cast<double>(c.slideSpeed));
+  }
   return m;
 }
+
+namespace {
+
+// Decoding errors name the cache file.
+std::optional<std::vector<cache::ColliderInfo>> readColliders(const cache::CacheReader& reader) {
+  try {
+    return cache::decodeColliders(reader.header().extensions);
+  } catch (const CorruptDataError& e) {
+    throw CorruptDataError(reader.path() + ": header: " + e.what());
+  }
+}
+
+FrameMetrics measure(const cache::CacheReader& reader, const cache::FrameRecord& frame) {
+  try {
+    return measureFrame(frame);
+  } catch (const CorruptDataError& e) {
+    throw CorruptDataError(reader.path() + ": " + e.what());
+  }
+}
+
+}  // namespace
 
 std::string inspectJson(const cache::CacheReader& reader) {
   const auto& header = reader.header();
@@ -76,10 +111,22 @@ std::string inspectJson(const cache::CacheReader& reader) {
   j.key("format_version").value(static_cast<long long>(header.formatVersion));
   j.key("fps").value(header.fps);
   j.key("frame_count").value(reader.frameCount());
+  const auto colliders = readColliders(reader);
+  if (colliders) {
+    j.key("colliders").beginArray();
+    for (const auto& c : *colliders) {
+      j.beginObject();
+      j.key("name").value(c.name);
+      j.key("material").value(c.material);
+      j.key("friction").value(c.friction);
+      j.endObject();
+    }
+    j.endArray();
+  }
   j.key("frames").beginArray();
   for (std::size_t i = 0; i < reader.frameCount(); ++i) {
     const auto frame = reader.readFrame(i);
-    const auto m = measureFrame(frame);
+    const auto m = measure(reader, frame);
     j.beginObject();
     j.key("frame").value(m.frame);
     j.key("time").value(m.time);
@@ -103,6 +150,10 @@ std::string inspectJson(const cache::CacheReader& reader) {
     j.key("singular_vertices").value(m.singularVertices);
     j.key("junction_vertices").value(m.junctionVertices);
     j.key("tears").value(m.tears);
+    if (colliders) {
+      j.key("contacts").value(m.contacts);
+      j.key("max_slide_speed").value(m.maxSlideSpeed);
+    }
     j.endObject();
   }
   j.endArray();
@@ -119,15 +170,34 @@ std::string inspectText(const cache::CacheReader& reader) {
                 reader.recovered() ? " (recovered: no valid footer)" : "");
   out += line;
   for (const auto& issue : reader.issues()) out += "  note: " + issue.message + "\n";
-  std::snprintf(line, sizeof line, "%6s %9s %8s %9s %10s %8s %10s %9s %12s\n", "frame", "time[s]",
+  const auto colliders = readColliders(reader);
+  if (colliders) {
+    out += "colliders: " + std::to_string(colliders->size()) + "\n";
+    for (std::size_t k = 0; k < colliders->size(); ++k) {
+      const auto& c = (*colliders)[k];
+      std::snprintf(line, sizeof line, ", mu %.6g\n", c.friction);
+      out += "  " + std::to_string(k) + ": " + c.name + ", material " + c.material + line;
+    }
+  }
+  std::snprintf(line, sizeof line, "%6s %9s %8s %9s %10s %8s %10s %9s %12s", "frame", "time[s]",
                 "verts", "tris", "c_mean", "n_comp", "max_strain", "dihedral", "handle_err[m]");
   out += line;
+  if (colliders) {
+    std::snprintf(line, sizeof line, " %8s %14s", "contacts", "max_slide[m/s]");
+    out += line;
+  }
+  out += "\n";
   for (std::size_t i = 0; i < reader.frameCount(); ++i) {
-    const auto m = measureFrame(reader.readFrame(i));
-    std::snprintf(line, sizeof line, "%6d %9.4f %8zu %9zu %10.3e %8.4f %10.3e %9.4f %12.3e\n",
+    const auto m = measure(reader, reader.readFrame(i));
+    std::snprintf(line, sizeof line, "%6d %9.4f %8zu %9zu %10.3e %8.4f %10.3e %9.4f %12.3e",
                   m.frame, m.time, m.vertices, m.triangles, m.cMean, m.nComp, m.maxStrain,
                   m.maxDihedral, m.handleError);
     out += line;
+    if (colliders) {
+      std::snprintf(line, sizeof line, " %8zu %14.3e", m.contacts, m.maxSlideSpeed);
+      out += line;
+    }
+    out += "\n";
   }
   return out;
 }

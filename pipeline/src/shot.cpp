@@ -16,6 +16,7 @@
 
 #include "crumple/core/error.hpp"
 #include "crumple/core/progress.hpp"
+#include "crumple/exporters/pcache_contacts.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/paper/hybrid_sheet.hpp"
 #include "crumple/paper/initial_sheet.hpp"
@@ -24,6 +25,7 @@
 #include "crumple/render/osmesa_renderer.hpp"
 #include "crumple/sim/colliders.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
+#include "crumple/sim/self_contact.hpp"
 #include "frame_output.hpp"
 #include "json_writer.hpp"
 
@@ -84,8 +86,11 @@ cache::CameraRecord cameraAt(const io::SceneSpec& scene, const io::AnimationScen
   return rec;
 }
 
-// The scene's [[colliders]] as a sim::ColliderSet; mesh colliders move
-// rigidly with their nodes (moveTo). Empty when the scene has none.
+// The scene's [[colliders]] as a sim::ColliderSet. Colliders with a node
+// move rigidly with it (moveTo): a mesh by the node's motion since t = 0
+// (its rest shape is the node's world-space mesh at t = 0), a box or sphere
+// by the node's world transform (its position is an offset in the node's
+// frame: a finger). Empty when the scene has none.
 class SceneColliders {
  public:
   SceneColliders(const io::SceneSpec& scene, const io::AnimationScene* animation)
@@ -108,7 +113,6 @@ class SceneColliders {
           shape.radius = c.radius;
           break;
         case io::ColliderSpec::Kind::Mesh: {
-          // The node's mesh in world space at t = 0 is the rest shape.
           const auto m = animation->mesh(c.node);
           shape.kind = sim::ColliderShape::Kind::Mesh;
           shape.vertices = m->vertices;
@@ -118,22 +122,31 @@ class SceneColliders {
         }
       }
       set_.add(c.name, std::move(shape), pose, c.friction);
+      info_.push_back({c.name, c.material, c.friction});
     }
+    moveTo(scene.frameTime(scene.frameStart));
   }
   bool empty() const { return set_.size() == 0; }
   const sim::ColliderSet& set() const { return set_; }
+  sim::ColliderSet& set() { return set_; }
+  const std::vector<cache::ColliderInfo>& info() const { return info_; }
 
-  // Mesh colliders to time t: the node's rigid motion since t = 0.
+  // Colliders with a node to time t.
   void moveTo(double t) {
     for (std::size_t i = 0; i < scene_.colliders.size(); ++i) {
       const auto& c = scene_.colliders[i];
       if (c.node.empty()) continue;
-      const Pose p0 = animation_->worldPose(c.node, 0.0);
       const Pose pt = animation_->worldPose(c.node, t);
-      Pose motion;
-      motion.rotation = pt.rotation * p0.rotation.conjugate();
-      motion.position = pt.position - motion.rotation * p0.position;
-      set_.setPose(static_cast<int>(i), motion);
+      Pose pose;
+      if (c.kind == io::ColliderSpec::Kind::Mesh) {
+        const Pose p0 = animation_->worldPose(c.node, 0.0);
+        pose.rotation = pt.rotation * p0.rotation.conjugate();
+        pose.position = pt.position - pose.rotation * p0.position;
+      } else {
+        pose.rotation = pt.rotation;
+        pose.position = pt.position + pt.rotation * c.position;
+      }
+      set_.setPose(static_cast<int>(i), pose);
     }
   }
 
@@ -141,7 +154,57 @@ class SceneColliders {
   const io::SceneSpec& scene_;
   const io::AnimationScene* animation_;
   sim::ColliderSet set_;
+  std::vector<cache::ColliderInfo> info_;
 };
+
+// The contact options of a shot (issue 5): its colliders, self-contact as
+// [contact] self says, paper on paper from [friction] paper.
+sim::ContactOptions contactOptionsOf(const io::SceneSpec& scene, SceneColliders& colliders) {
+  sim::ContactOptions o;
+  o.distance = scene.paper.thickness;
+  if (!colliders.empty()) {
+    o.colliders = &colliders.set();
+    o.moveColliders = [&colliders](double t) { colliders.moveTo(t); };
+  }
+  switch (scene.contact.self) {
+    case io::ContactSpec::Self::Off:
+      o.self = sim::SelfContactMode::Off;
+      break;
+    case io::ContactSpec::Self::On:
+      o.self = sim::SelfContactMode::On;
+      break;
+    case io::ContactSpec::Self::Auto:
+      o.self = sim::SelfContactMode::Auto;
+      break;
+  }
+  o.selfFriction = scene.friction.at("paper");
+  return o;
+}
+
+// How deep (in thicknesses) the deepest free vertex of a frame lies inside
+// a collider or inside another layer of the sheet: the contact distance
+// minus its distance, 0 when none is nearer (issue 5's acceptance,
+// measured at every frame). Handle vertices are the artist's to place.
+double contactDepth(const sim::ContactOptions& contact, const cache::FrameRecord& record) {
+  const double d = contact.distance;
+  std::vector<char> free(record.positions.size(), 1);
+  for (int v : record.handleVertices)
+    if (v >= 0 && static_cast<std::size_t>(v) < free.size()) free[static_cast<std::size_t>(v)] = 0;
+  double depth = 0.0;
+  if (contact.colliders != nullptr) {
+    for (std::size_t i = 0; i < record.positions.size(); ++i) {
+      if (free[i] == 0) continue;
+      if (const auto c = contact.colliders->nearest(record.positions[i], d))
+        depth = std::max(depth, (d - c->distance) / d);
+    }
+  }
+  if (contact.self != sim::SelfContactMode::Off) {
+    sim::SelfContactDetector detector(record.triangles, record.pattern, d);
+    for (const auto& p : detector.find(record.positions, d, &free))
+      depth = std::max(depth, (d - p.distance) / d);
+  }
+  return depth;
+}
 
 // After the frames: the contact sheet (DIR/contact_sheet.png) and the movie
 // (DIR/preview.mp4, with DIR/sound.wav when there is one), DIR being the
@@ -331,11 +394,6 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   }
   const double t0 = frameTime(scene, scene.frameStart);
   const bool hybridModel = scene.model.type == io::ModelSpec::Type::Hybrid;
-  if (hybridModel && !scene.colliders.empty())
-    throw InputError(
-        scene.file,
-        "'colliders': contacts are simulated with the elastic model only so far; the "
-        "crumpling model ([model] type = \"hybrid\") does not take them yet (issue 5)");
   sim::SimParams params;
   params.gravity = scene.sim.gravity;
   params.massDamping = scene.sim.massDamping;
@@ -387,8 +445,16 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
 
   std::optional<sim::ElasticSheet> elastic;
   if (!hybrid) elastic.emplace(sheet, materialOf(scene.paper), params);
+  // Contacts (issue 5): none of it runs without colliders and with [contact] self = false.
   SceneColliders colliders(scene, animation.get());
-  if (elastic && !colliders.empty()) elastic->setColliders(&colliders.set(), scene.paper.thickness);
+  const sim::ContactOptions contact = contactOptionsOf(scene, colliders);
+  const bool contactsOn = !colliders.empty() || contact.self != sim::SelfContactMode::Off;
+  report.contactsOn = contactsOn;
+  report.selfContactMode = contact.self == sim::SelfContactMode::On    ? "on"
+                           : contact.self == sim::SelfContactMode::Off ? "off"
+                                                                       : "auto";
+  if (elastic) elastic->setContacts(contact);
+  if (hybrid) hybrid->setContacts(contact);
 
   cache::CacheHeader header;
   header.fps = scene.fps;
@@ -406,6 +472,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   header.paperThickness = scene.paper.thickness;
   for (const auto& h : rig.handles()) header.handleNames.push_back(h.name);
   header.extensions = lookBlocks;
+  if (contactsOn) header.extensions.push_back(cache::encodeColliders(colliders.info()));
   cache::CacheWriter writer(report.cachePath, header);
 
   cache::FrameRecord record;
@@ -463,6 +530,25 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     record.extensions.clear();
     if (auto motions = propMotionBlock(scene, animation.get(), t))
       record.extensions.push_back(std::move(*motions));
+    if (contactsOn) {
+      // What the sheet touches at the end of the frame (the sound module's input).
+      const auto& samples = hybrid ? hybrid->contacts() : elastic->contacts();
+      std::vector<cache::ContactRecord> touching;
+      touching.reserve(samples.size());
+      for (const auto& c : samples)
+        touching.push_back({c.vertex, c.collider < 0 ? cache::kSelfContact : c.collider,
+                            static_cast<float>(c.slideSpeed), static_cast<float>(c.normalForce)});
+      if (!touching.empty()) record.extensions.push_back(cache::encodeContacts(touching));
+      report.contactSamples += static_cast<long>(touching.size());
+      const auto depthStart = Clock::now();
+      const double depth = contactDepth(contact, record);
+      report.stages["contact check"].totalMs += msSince(depthStart);
+      report.stages["contact check"].frames += 1;
+      if (depth > report.maxContactDepth) {
+        report.maxContactDepth = depth;
+        report.maxContactDepthFrame = frame;
+      }
+    }
     auto start = Clock::now();
     writer.append(record);
     report.stages["cache"].totalMs += msSince(start);
@@ -498,12 +584,18 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
         report.halvings += stats.elastic.halvings;
         report.elasticRetries += stats.elasticRetries;
         report.substeps += scene.substeps;
-        const std::pair<const char*, double> stages[] = {{"elastic", stats.ms.elastic},
-                                                         {"geometric", stats.ms.geometric},
-                                                         {"cones", stats.ms.cones},
-                                                         {"rebuild", stats.ms.rebuild},
-                                                         {"isometry", stats.ms.isometry}};
+        report.contactMs += stats.elastic.contactMs + stats.ms.contacts;
+        report.selfContactMs += stats.elastic.selfContactMs + stats.ms.selfContacts;
+        report.selfContactSteps += stats.elastic.selfContactSteps;
+        const std::pair<const char*, double> stages[] = {
+            {"elastic", stats.ms.elastic},
+            {"geometric", stats.ms.geometric},
+            {"cones", stats.ms.cones},
+            {"rebuild", stats.ms.rebuild},
+            {"isometry", stats.ms.isometry},
+            {"contacts", stats.ms.contacts + stats.ms.selfContacts}};
         for (const auto& [name, ms] : stages) {
+          if (!contactsOn && std::string_view(name) == "contacts") continue;
           report.stages[name].totalMs += ms;
           report.stages[name].frames += 1;
         }
@@ -515,11 +607,12 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
         // Substep s of frame f starts at ((f - 1) * substeps + s) * dt.
         const double t = static_cast<double>((frame - 1) * scene.substeps + s) * dt;
         try {
-          if (!colliders.empty()) colliders.moveTo(t + dt);
           const auto stats = elastic->advance(t, dt, pins);
           report.newtonIterations += stats.newtonIterations;
           report.halvings += stats.halvings;
           report.contactMs += stats.contactMs;
+          report.selfContactMs += stats.selfContactMs;
+          report.selfContactSteps += stats.selfContactSteps;
           ++report.substeps;
         } catch (const NumericalError& e) {
           throw NumericalError(e.stage(), frame, e.problem());
@@ -612,6 +705,13 @@ const char* backendName(RenderSettings::Backend backend) {
   return backend == RenderSettings::Backend::Embree ? "embree" : "osmesa";
 }
 
+double ShotReport::contactShareOfStep() const {
+  double step = 0.0;
+  for (const char* name : {"elastic", "geometric", "cones", "rebuild", "isometry", "contacts"})
+    if (const auto it = stages.find(name); it != stages.end()) step += it->second.totalMs;
+  return step > 0.0 ? (contactMs + selfContactMs) / step : 0.0;
+}
+
 std::string summaryText(const ShotReport& r) {
   std::string out;
   char line[512];
@@ -630,11 +730,14 @@ std::string summaryText(const ShotReport& r) {
                 r.substeps > 0 ? static_cast<double>(r.newtonIterations) / r.substeps : 0.0,
                 r.halvings, r.maxHandleError, r.maxStrain);
   out += line;
-  if (r.contactMs > 0.0 && r.stages.count("elastic") && r.stages.at("elastic").frames > 0) {
-    const auto& e = r.stages.at("elastic");
-    std::snprintf(line, sizeof line, "  contacts %.2f ms/frame (%.0f %% of the elastic step)\n",
-                  r.contactMs / static_cast<double>(e.frames),
-                  e.totalMs > 0.0 ? 100.0 * r.contactMs / e.totalMs : 0.0);
+  if (r.contactsOn) {
+    const double frames = std::max(1, r.framesSimulated - 1);
+    std::snprintf(line, sizeof line,
+                  "  contacts %.2f ms/frame colliders + %.2f ms/frame self-contact (%s, ran in %ld "
+                  "substeps): %.1f %% of the step; deepest vertex %.3f thicknesses in (frame %d)\n",
+                  r.contactMs / frames, r.selfContactMs / frames, r.selfContactMode.c_str(),
+                  r.selfContactSteps, 100.0 * r.contactShareOfStep(), r.maxContactDepth,
+                  r.maxContactDepthFrame);
     out += line;
   }
   out += "  cache:   " + r.cachePath + "\n";
@@ -672,7 +775,7 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
   j.key("elastic").value(true);
   j.key("crumpling_model").value(r.hybrid);
   j.key("contacts").value(!scene.colliders.empty());
-  j.key("self_contact").value(false);
+  j.key("self_contact").value(r.selfContactSteps > 0);
   j.key("tearing").value(false);
   j.key("sound").value(false);
   j.key("render_osmesa").value(r.framesRendered > 0 && r.renderBackend == "osmesa");
@@ -681,13 +784,23 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
   j.key("ms_per_frame").beginObject();
   for (const auto& [name, cost] : r.stages) j.key(name).value(cost.msPerFrame());
   j.endObject();
-  if (!scene.colliders.empty()) {
-    // Contact detection and the failsafe, part of the elastic stage's time.
-    const long frames = r.stages.count("elastic") ? r.stages.at("elastic").frames : 0;
-    const double elasticMs = r.stages.count("elastic") ? r.stages.at("elastic").totalMs : 0.0;
-    j.key("contact_ms_per_frame")
-        .value(frames > 0 ? r.contactMs / static_cast<double>(frames) : 0.0);
-    j.key("contact_share_of_elastic").value(elasticMs > 0.0 ? r.contactMs / elasticMs : 0.0);
+  if (r.contactsOn) {
+    // Issue 5: what contacts cost (detection, penalties' setup and the
+    // failsafe; the Newton iterations they add are the elastic stage's) and
+    // the deepest any free vertex went, measured at every frame.
+    const double frames = std::max(1, r.framesSimulated - 1);
+    j.key("contacts").beginObject();
+    j.key("colliders").value(static_cast<long long>(scene.colliders.size()));
+    j.key("self_contact_mode").value(r.selfContactMode);
+    j.key("self_contact_substeps").value(static_cast<long long>(r.selfContactSteps));
+    j.key("collider_ms_per_frame").value(r.contactMs / frames);
+    j.key("self_contact_ms_per_frame").value(r.selfContactMs / frames);
+    j.key("share_of_step").value(r.contactShareOfStep());
+    j.key("contacts_per_frame")
+        .value(static_cast<double>(r.contactSamples) / std::max(1, r.framesSimulated));
+    j.key("max_depth_thicknesses").value(r.maxContactDepth);
+    j.key("max_depth_frame").value(r.maxContactDepthFrame);
+    j.endObject();
   }
   j.key("newton_iterations").value(static_cast<long long>(r.newtonIterations));
   j.key("substep_halvings").value(static_cast<long long>(r.halvings));

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -800,6 +802,222 @@ friction = 0.5
   expectError(kSheet + "[[colliders]]\ntype = \"plane\"\n[[colliders]]\ntype = \"plane\"\n" +
                   "name = \"collider0\"\n",
               8, "colliders[1].name", {"duplicate"});
+}
+
+// ---- [friction], collider materials, nodes on boxes and spheres, [contact] -------
+
+TEST(SceneColliders, FrictionDefaultsWithoutTable) {
+  const SceneSpec s = parse(kSheet + "[[colliders]]\ntype = \"plane\"\n");
+  const std::map<std::string, double> builtIn{{"default", 0.3}, {"paper", 0.3}};
+  EXPECT_EQ(s.friction, builtIn);
+  ASSERT_EQ(s.colliders.size(), 1u);
+  EXPECT_EQ(s.colliders[0].material, "default");
+  EXPECT_DOUBLE_EQ(s.colliders[0].friction, 0.3);
+  // Also without any collider.
+  EXPECT_EQ(parse(kSheet).friction, builtIn);
+}
+
+TEST(SceneColliders, FrictionFromMaterialExplicitOrDefault) {
+  const SceneSpec s = parse(kSheet + R"(
+[friction]
+default = 0.1
+paper = 0.25
+wood = 0.4
+steel_2-b = 0.2
+[[colliders]]
+name = "table"
+type = "plane"
+material = "wood"
+[[colliders]]
+name = "both"
+type = "plane"
+material = "wood"
+friction = 0.7
+[[colliders]]
+name = "explicit"
+type = "plane"
+friction = 0
+[[colliders]]
+name = "plain"
+type = "plane"
+[[colliders]]
+name = "odd"
+type = "plane"
+material = "steel_2-b"
+)");
+  const std::map<std::string, double> table{
+      {"default", 0.1}, {"paper", 0.25}, {"wood", 0.4}, {"steel_2-b", 0.2}};
+  EXPECT_EQ(s.friction, table);
+  ASSERT_EQ(s.colliders.size(), 5u);
+  // material looks the table up
+  EXPECT_EQ(s.colliders[0].material, "wood");
+  EXPECT_DOUBLE_EQ(s.colliders[0].friction, 0.4);
+  // explicit friction wins over the material, whose name is kept
+  EXPECT_EQ(s.colliders[1].material, "wood");
+  EXPECT_DOUBLE_EQ(s.colliders[1].friction, 0.7);
+  // explicit friction without material: "custom" (0 is allowed)
+  EXPECT_EQ(s.colliders[2].material, "custom");
+  EXPECT_DOUBLE_EQ(s.colliders[2].friction, 0.0);
+  // neither: the table's (overridden) default, not the built-in 0.3
+  EXPECT_EQ(s.colliders[3].material, "default");
+  EXPECT_DOUBLE_EQ(s.colliders[3].friction, 0.1);
+  EXPECT_EQ(s.colliders[4].material, "steel_2-b");
+  EXPECT_DOUBLE_EQ(s.colliders[4].friction, 0.2);
+}
+
+TEST(SceneColliders, FrictionTableMayFollowColliders) {
+  const SceneSpec s = parse(kSheet + R"(
+[[colliders]]
+type = "sphere"
+radius = 0.1
+material = "wood"
+[[colliders]]
+type = "plane"
+[friction]
+wood = 0.45
+default = 0.05
+)");
+  ASSERT_EQ(s.colliders.size(), 2u);
+  EXPECT_EQ(s.colliders[0].material, "wood");
+  EXPECT_DOUBLE_EQ(s.colliders[0].friction, 0.45);
+  EXPECT_EQ(s.colliders[1].material, "default");
+  EXPECT_DOUBLE_EQ(s.colliders[1].friction, 0.05);
+}
+
+TEST(SceneColliders, UnknownMaterialNamesItAndTheTable) {
+  const std::string text = kSheet + "[[colliders]]\ntype = \"plane\"\nmaterial = \"wood\"\n";
+  try {
+    parse(text);
+    ADD_FAILURE() << text;
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "test.toml:6: 'colliders[0].material': material 'wood' has no coefficient: add it "
+              "to [friction] (known: default, paper)");
+  }
+  expectError(kSheet + "[friction]\nsteel = 0.2\n[[colliders]]\ntype = \"plane\"\n" +
+                  "material = \"wood\"\n",
+              8, "colliders[0].material", {"'wood'", "(known: default, paper, steel)"});
+  // An explicit friction does not look the material up.
+  EXPECT_DOUBLE_EQ(parse(text + "friction = 0.6\n").colliders[0].friction, 0.6);
+}
+
+TEST(SceneColliders, BadFrictionValuesAndNames) {
+  expectError(kSheet + "[friction]\nwood = -0.1\n", 5, "friction.wood", {"must be >= 0", "-0.1"});
+  expectError(kSheet + "[friction]\nwood = 0.4\ndefault = -1\n", 6, "friction.default",
+              {"must be >= 0"});
+  expectError(kSheet + "[friction]\npaper = inf\n", 5, "friction.paper", {"finite"});
+  expectError(kSheet + "[friction]\nwood = \"rough\"\n", 5, "friction.wood",
+              {"expected a number", "a string"});
+  expectError(kSheet + "[friction]\nsteel = 0.2\nWood = 0.4\n", 6, "friction.Wood",
+              {"not a material name", "a-z"});
+  expectError(kSheet + "[friction]\n\"oak wood\" = 0.4\n", 5, "friction.oak wood",
+              {"not a material name"});
+  expectError(kSheet + "[[colliders]]\ntype = \"plane\"\nfriction = -1\n", 6,
+              "colliders[0].friction", {"must be >= 0"});
+  expectError(kSheet + "[[colliders]]\ntype = \"plane\"\nmaterial = \"Wood\"\n", 6,
+              "colliders[0].material", {"not a material name"});
+  expectError(kSheet + "[[colliders]]\ntype = \"plane\"\nmaterial = 3\n", 6,
+              "colliders[0].material", {"expected a string"});
+  expectError(kSheet + "friction = 0.3\n", 4, "sheet.friction", {"unknown key"});
+}
+
+TEST(SceneColliders, BoxAndSphereFollowAnyNode) {
+  const std::string good = R"([scene]
+units = "cm"
+animation = "anim.glb"
+[sheet]
+width = 21
+height = 29.7
+[[colliders]]
+name = "fingertip"
+type = "sphere"
+radius = 1
+node = "Handle"
+position = [0, -2, 0]
+[[colliders]]
+type = "box"
+size = [2, 2, 2]
+node = "Static"
+)";
+  const SceneSpec s = parse(good);
+  ASSERT_EQ(s.colliders.size(), 2u);
+  const ColliderSpec& sphere = s.colliders[0];
+  EXPECT_EQ(sphere.kind, ColliderSpec::Kind::Sphere);
+  EXPECT_EQ(sphere.name, "fingertip");
+  EXPECT_EQ(sphere.node, "Handle");
+  EXPECT_EQ(sphere.nodeLine, 11);
+  EXPECT_TRUE(sphere.position.isApprox(Vec3(0, -0.02, 0)));  // offset, in metres
+  EXPECT_NEAR(sphere.radius, 0.01, 1e-15);
+  const ColliderSpec& box = s.colliders[1];
+  EXPECT_EQ(box.kind, ColliderSpec::Kind::Box);
+  EXPECT_EQ(box.name, "Static");  // named after its node
+  EXPECT_EQ(box.node, "Static");
+  EXPECT_EQ(box.nodeLine, 16);
+  EXPECT_TRUE(box.position.isZero());  // default offset
+
+  // Handle and Static hold no mesh: a box or sphere only needs the transform.
+  const AnimationScene anim = AnimationScene::load(s.animationFile);
+  for (const char* node : {"Handle", "Static"}) {
+    const std::optional<ImportedMesh> m = anim.mesh(node);
+    ASSERT_TRUE(!m || m->triangles.empty()) << node;
+  }
+  EXPECT_NO_THROW(checkAnimationNodes(s, anim));
+
+  // The node must still exist...
+  std::string text = good;
+  const SceneSpec missing = parse(text.replace(text.find("\"Handle\""), 8, "\"Thumb\""));
+  try {
+    checkAnimationNodes(missing, anim);
+    ADD_FAILURE() << "node Thumb accepted";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind("test.toml:11: 'colliders[0].node': ", 0), 0u) << msg;
+    EXPECT_NE(msg.find("no node named 'Thumb'"), std::string::npos) << msg;
+  }
+  // ...and a mesh collider still needs triangles.
+  const SceneSpec mesh = parse(kAnimSheet + "[[colliders]]\ntype = \"mesh\"\nnode = \"Handle\"\n");
+  try {
+    checkAnimationNodes(mesh, anim);
+    ADD_FAILURE() << "mesh collider on a transform node accepted";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind("test.toml:8: 'colliders[0].node': ", 0), 0u) << msg;
+    EXPECT_NE(msg.find("holds no triangle mesh"), std::string::npos) << msg;
+  }
+}
+
+TEST(SceneColliders, NodeErrors) {
+  expectError(kAnimSheet + "[[colliders]]\ntype = \"plane\"\nnode = \"Handle\"\n", 8,
+              "colliders[0].node", {"only for meshes, boxes and spheres"});
+  expectError(kSheet + "[[colliders]]\ntype = \"sphere\"\nradius = 1\nnode = \"Handle\"\n", 7,
+              "colliders[0].node", {"animation file"});
+  expectError(kSheet + "[[colliders]]\ntype = \"box\"\nsize = [1, 1, 1]\nnode = \"Handle\"\n", 7,
+              "colliders[0].node", {"animation file"});
+  expectError(kAnimSheet + "[[colliders]]\ntype = \"box\"\nsize = [1, 1, 1]\nnode = \"\"\n", 9,
+              "colliders[0].node", {"must not be empty"});
+}
+
+TEST(SceneContact, SelfParsesTrueFalseAuto) {
+  EXPECT_EQ(parse(kSheet).contact.self, ContactSpec::Self::Auto);
+  EXPECT_EQ(parse(kSheet + "[contact]\n").contact.self, ContactSpec::Self::Auto);
+  EXPECT_EQ(parse(kSheet + "[contact]\nself = true\n").contact.self, ContactSpec::Self::On);
+  EXPECT_EQ(parse(kSheet + "[contact]\nself = false\n").contact.self, ContactSpec::Self::Off);
+  EXPECT_EQ(parse(kSheet + "[contact]\nself = \"auto\"\n").contact.self, ContactSpec::Self::Auto);
+  // [contact] may come anywhere, e.g. first.
+  EXPECT_EQ(parse("[contact]\nself = true\n" + kSheet).contact.self, ContactSpec::Self::On);
+}
+
+TEST(SceneContact, SelfRejectsOtherValues) {
+  expectError(kSheet + "[contact]\nself = \"yes\"\n", 5, "contact.self",
+              {"expected true, false or \"auto\"", "\"yes\""});
+  expectError(kSheet + "[contact]\nself = \"Auto\"\n", 5, "contact.self", {"\"Auto\""});
+  expectError(kSheet + "[contact]\nself = 1\n", 5, "contact.self",
+              {"expected true, false or \"auto\"", "an integer"});
+  expectError(kSheet + "[contact]\nself = [true]\n", 5, "contact.self", {"an array"});
+  expectError(kSheet + "[contact]\nself = true\nfriction = 0.3\n", 6, "contact.friction",
+              {"unknown key", "self"});
+  expectError(kSheet + "contact = true\n", 4, "sheet.contact", {"unknown key"});
+  expectError("contact = true\n" + kSheet, 1, "contact", {"expected a table"});
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "crumple/core/error.hpp"
 #include "crumple/core/parallel.hpp"
 #include "crumple/exporters/pcache.hpp"
+#include "crumple/exporters/pcache_contacts.hpp"
 #include "crumple/io/animation.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/handle_rig.hpp"
@@ -569,11 +570,43 @@ frames = false
   for (const Vec3& x : last.positions) EXPECT_LT(x.y(), 2.0 * thickness) << "lies on the table";
   const auto summary = readFile(tmp / "out1/summary.json");
   EXPECT_NE(summary.find("\"contacts\":true"), std::string::npos) << summary;
-  EXPECT_NE(summary.find("\"contact_ms_per_frame\""), std::string::npos) << summary;
-  // The crumpling model does not take colliders yet: said, exit 2, nothing written.
-  writeFile(tmp / "s/scene.toml", readFile(tmp / "s/scene.toml") + "[model]\ntype = \"hybrid\"\n");
-  const auto h = runCrumple("simulate " + (tmp / "s").string() + " --out " + (tmp / "h").string());
-  EXPECT_EQ(h.status, 2) << h.output;
-  EXPECT_NE(h.output.find("elastic model only"), std::string::npos) << h.output;
-  EXPECT_FALSE(fs::exists(tmp / "h/cache.pcache"));
+  EXPECT_NE(summary.find("\"collider_ms_per_frame\""), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"max_depth_thicknesses\""), std::string::npos) << summary;
+  // The contact set travels in the cache: the colliders by name, and the
+  // vertices lying on the table at the last frame, not sliding.
+  const auto colliders = cache::decodeColliders(reader.header().extensions);
+  ASSERT_TRUE(colliders.has_value());
+  ASSERT_EQ(colliders->size(), 2u);
+  EXPECT_EQ((*colliders)[0].name, "table");
+  EXPECT_DOUBLE_EQ((*colliders)[0].friction, 0.3);
+  const auto touching = cache::decodeContacts(last.extensions);
+  ASSERT_TRUE(touching.has_value());
+  EXPECT_EQ(touching->size(), last.positions.size()) << "every vertex lies on the table";
+  double weight = 0.0;
+  for (const auto& c : *touching) {
+    EXPECT_EQ(c.collider, 0);
+    EXPECT_LT(c.slideSpeed, 1e-3);
+    weight += c.normalForce;
+  }
+  EXPECT_NEAR(weight, 0.070002 * 0.01 * 9.81, 0.1 * 0.070002 * 0.01 * 9.81) << "carries the sheet";
+  // Without colliders and with self-contact off: no contact work, no blocks.
+  writeFile(tmp / "s/scene.toml", R"([scene]
+name = "free"
+frames = [1, 4]
+[sheet]
+width = 0.1
+height = 0.1
+max_edge = 0.025
+[contact]
+self = false
+[output]
+frames = false
+)");
+  const auto f = runCrumple("simulate " + (tmp / "s").string() + " --out " + (tmp / "f").string());
+  ASSERT_EQ(f.status, 0) << f.output;
+  const auto freeSummary = readFile(tmp / "f/summary.json");
+  EXPECT_EQ(freeSummary.find("\"contacts\":{"), std::string::npos) << freeSummary;
+  EXPECT_EQ(freeSummary.find("contact check"), std::string::npos) << freeSummary;
+  const cache::CacheReader freeReader((tmp / "f/cache.pcache").string());
+  EXPECT_FALSE(cache::decodeColliders(freeReader.header().extensions).has_value());
 }

@@ -146,6 +146,14 @@ mesh::SheetMesh flatSheet(double y, double maxEdge = 0.02) {
   return m;
 }
 
+// Contacts with `set` at `distance`, no self-contact.
+ContactOptions collide(const ColliderSet* set, double distance) {
+  ContactOptions o;
+  o.colliders = set;
+  o.distance = distance;
+  return o;
+}
+
 const PinFunction kNoPins = [](double, std::vector<Pin>& out) { out.clear(); };
 
 TEST(Contacts, ASheetDroppedOnATableComesToRestOnIt) {
@@ -153,7 +161,7 @@ TEST(Contacts, ASheetDroppedOnATableComesToRestOnIt) {
   ElasticSheet sheet(flatSheet(0.02), paper, SimParams{});
   ColliderSet table;
   table.add("table", ColliderShape{}, at(Vec3::Zero()));
-  sheet.setColliders(&table, paper.thickness);
+  sheet.setContacts(collide(&table, paper.thickness));
   const double dt = 1.0 / 96.0;
   double lowest = 1.0;
   for (int step = 0; step < 96; ++step) {  // 1 s: falls 2 cm in ~64 ms, then rests
@@ -174,7 +182,7 @@ TEST(Contacts, ASheetDrapesOverASphereWithoutEnteringIt) {
   ElasticSheet sheet(flatSheet(0.031, 0.01), paper, SimParams{});
   ColliderSet ball;
   ball.add("ball", sphere(0.03), at(Vec3::Zero()));
-  sheet.setColliders(&ball, paper.thickness);
+  sheet.setContacts(collide(&ball, paper.thickness));
   const double dt = 1.0 / 384.0;
   double nearest = 1.0;
   for (int step = 0; step < 192; ++step) {  // 0.5 s
@@ -197,12 +205,12 @@ TEST(Contacts, WithoutCollidersTheSheetFallsThrough) {
   ElasticSheet sheet(flatSheet(0.02), paper, SimParams{});
   ColliderSet table;
   table.add("table", ColliderShape{}, at(Vec3::Zero()));
-  sheet.setColliders(&table, paper.thickness);
-  sheet.setColliders(nullptr, 0.0);  // switched off again
+  sheet.setContacts(collide(&table, paper.thickness));
+  sheet.setContacts({});  // switched off again
   for (int step = 0; step < 48; ++step) sheet.advance(step / 96.0, 1.0 / 96.0, kNoPins);
   EXPECT_LT(sheet.positions()[0].y(), -0.1);
   EXPECT_EQ(sheet.contactVertexSteps(), 0);
-  EXPECT_THROW(sheet.setColliders(&table, 0.0), std::invalid_argument);
+  EXPECT_THROW(sheet.setContacts(collide(&table, 0.0)), std::invalid_argument);
 }
 
 // The centroid's travel over `seconds` of a sheet resting on a plane tilted
@@ -215,7 +223,7 @@ double slideOnSlope(double slope, double mu, double seconds) {
   ElasticSheet sheet(m, paper, SimParams{});
   ColliderSet slopeSet;
   slopeSet.add("slope", ColliderShape{}, at(Vec3::Zero(), tilt), mu);
-  sheet.setColliders(&slopeSet, paper.thickness);
+  sheet.setContacts(collide(&slopeSet, paper.thickness));
   const auto centroid = [&] {
     Vec3 c = Vec3::Zero();
     for (const Vec3& x : sheet.positions()) c += x;
@@ -245,6 +253,62 @@ TEST(Contacts, FrictionHoldsASheetOnA10DegreeSlopeAndLetsItSlideOn30) {
   EXPECT_LT(slid, 1.6);
   // Without friction even 10 degrees slides: g sin 10 = 1.7 m/s^2.
   EXPECT_GT(frictionless, 0.4);
+}
+
+TEST(Contacts, AMovingPlateDragsTheSheetAlongByFriction) {
+  // A sheet resting on a plate that slides along +X at 0.2 m/s: friction
+  // relative to the plate's surface carries the sheet with it (mu 0.5); on
+  // a frictionless plate the sheet stays where it was.
+  const auto travel = [](double mu) {
+    const Material paper;
+    ElasticSheet sheet(flatSheet(paper.thickness), paper, SimParams{});
+    ColliderSet plate;
+    const int id = plate.add("plate", box(Vec3(0.5, 0.01, 0.5)), at(Vec3(0, -0.01, 0)), mu);
+    ContactOptions options;
+    options.colliders = &plate;
+    options.distance = paper.thickness;
+    options.moveColliders = [&plate, id](double t) {
+      plate.setPose(id, at(Vec3(0.2 * t, -0.01, 0)));
+    };
+    sheet.setContacts(options);
+    const double x0 = sheet.positions()[0].x();
+    double lowest = 1.0;
+    const double dt = 1.0 / 96.0;
+    for (int step = 0; step < 48; ++step) {  // 0.5 s: the plate moves 10 cm
+      sheet.advance(step * dt, dt, kNoPins);
+      for (const Vec3& x : sheet.positions()) lowest = std::min(lowest, x.y());
+    }
+    EXPECT_GE(lowest, 0.9 * paper.thickness) << "mu " << mu;
+    EXPECT_FALSE(sheet.contacts().empty()) << "it touches the plate";
+    return sheet.positions()[0].x() - x0;
+  };
+  const double dragged = travel(0.5), left = travel(0.0);
+  std::cout << "[ measure ] plate moved 0.1 m; sheet moved " << dragged << " m (mu 0.5), " << left
+            << " m (mu 0)\n";
+  EXPECT_GT(dragged, 0.09) << "carried with the plate (static friction)";
+  EXPECT_LT(std::abs(left), 0.005) << "nothing drags a sheet on a frictionless plate";
+}
+
+TEST(Contacts, ContactSamplesReportTheSlidingSpeedAndTheWeight) {
+  const Material paper;
+  ElasticSheet sheet(flatSheet(paper.thickness), paper, SimParams{});
+  sheet.setVelocities(std::vector<Vec3>(sheet.positions().size(), Vec3(0.5, 0, 0)));
+  ColliderSet table;
+  table.add("table", ColliderShape{}, at(Vec3::Zero()), 0.0);  // frictionless: keeps sliding
+  sheet.setContacts(collide(&table, paper.thickness));
+  for (int step = 0; step < 24; ++step) sheet.advance(step / 96.0, 1.0 / 96.0, kNoPins);
+  const auto& contacts = sheet.contacts();
+  ASSERT_EQ(contacts.size(), sheet.positions().size()) << "every vertex lies on the table";
+  double force = 0.0;
+  for (std::size_t i = 0; i < contacts.size(); ++i) {
+    EXPECT_EQ(contacts[i].vertex, static_cast<int>(i));
+    EXPECT_EQ(contacts[i].collider, 0);
+    // Mass damping (0.5/s) slows it: 0.5 exp(-0.5 * 0.25) = 0.44 m/s.
+    EXPECT_NEAR(contacts[i].slideSpeed, 0.5 * std::exp(-0.5 * 0.25), 0.01);
+    force += contacts[i].normalForce;
+  }
+  const double weight = paper.arealDensity() * 0.01 * 9.81;
+  EXPECT_NEAR(force, weight, 0.05 * weight) << "the table carries the sheet's weight";
 }
 
 }  // namespace

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <optional>
 #include <set>
+#include <utility>
+#include <vector>
 
 #include "crumple/core/error.hpp"
 #include "crumple/core/units.hpp"
@@ -29,6 +31,19 @@ constexpr double kMaxRhoBoundPerCm = 100.0;   // 0.1 mm between boundary samples
 constexpr double kMaxRhoIntPerCm2 = 10000.0;  // 0.1 mm between interior samples
 constexpr double kMaxSigmaCm = 100.0;
 constexpr std::int64_t kMaxIsometryIterations = 100000;
+// Coulomb coefficient of the built-in [friction] entries "default" and "paper".
+constexpr double kDefaultFriction = 0.3;
+
+// A [friction] material name: non-empty, only a-z, 0-9, _ and -.
+bool isMaterialName(const std::string& name) {
+  return !name.empty() && std::all_of(name.begin(), name.end(), [](char ch) {
+    return (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '_' || ch == '-';
+  });
+}
+
+std::string notMaterialName(const std::string& name) {
+  return "'" + name + "' is not a material name (use only a-z, 0-9, _ and -)";
+}
 
 class SceneParser {
  public:
@@ -46,7 +61,8 @@ class SceneParser {
   SceneSpec parse() {
     const TableReader root(root_, "", file_);
     root.allowOnly({"scene", "sheet", "paper", "handles", "camera", "lights", "environment",
-                    "ground", "props", "colliders", "output", "sim", "model"});
+                    "ground", "props", "colliders", "friction", "contact", "output", "sim",
+                    "model"});
     // [scene] first: its `units` scales every length that follows.
     parseScene(root.subTable("scene"));
     const toml::table* sheet = root.subTable("sheet");
@@ -59,7 +75,11 @@ class SceneParser {
     parseEnvironment(root.subTable("environment"));
     parseGround(root.subTable("ground"));
     parseProps(root);
+    // [friction] before the colliders that look their material up in it (toml++
+    // parses the whole file first, so [friction] may follow [[colliders]]).
+    parseFriction(root.subTable("friction"));
     parseColliders(root);
+    parseContact(root.subTable("contact"));
     parseOutput(root.subTable("output"));
     parseSim(root.subTable("sim"));
     parseModel(root.subTable("model"));
@@ -500,12 +520,25 @@ class SceneParser {
     for (std::size_t i = 0; i < colliders->size(); ++i) {
       const TableReader r(*colliders->get(i)->as_table(), "colliders[" + std::to_string(i) + "]",
                           file_);
-      r.allowOnly({"name", "type", "position", "normal", "size", "radius", "node", "friction"});
+      r.allowOnly(
+          {"name", "type", "position", "normal", "size", "radius", "node", "material", "friction"});
       ColliderSpec c;
       const std::optional<std::string> type = r.string("type");
       if (!type) r.missing("type");
       const auto only = [&](const char* key, const char* types) {
         if (r.has(key)) r.fail(key, std::string("only for ") + types);
+      };
+      // A box or sphere may follow any node (position is then its offset).
+      const auto followNode = [&](const std::string& what) {
+        const std::optional<std::string> node = r.string("node");
+        if (!node) return;
+        if (node->empty()) r.fail("node", "must not be empty");
+        if (spec_.animationFile.empty()) {
+          r.fail("node",
+                 "a " + what + " following a node needs an animation file ([scene] animation)");
+        }
+        c.node = *node;
+        c.nodeLine = r.lineOf("node");
       };
       if (auto p = r.vec3("position")) c.position = *p * mpu();
       if (*type == "plane") {
@@ -513,7 +546,7 @@ class SceneParser {
         if (auto n = r.vec3("normal")) c.normal = r.requireDirection("normal", *n);
         only("size", "boxes");
         only("radius", "spheres");
-        only("node", "meshes");
+        only("node", "meshes, boxes and spheres");
       } else if (*type == "box") {
         c.kind = ColliderSpec::Kind::Box;
         const std::optional<Vec3> sz = r.vec3("size");
@@ -522,7 +555,7 @@ class SceneParser {
         c.size = *sz * mpu();
         only("normal", "planes");
         only("radius", "spheres");
-        only("node", "meshes");
+        followNode("box");
       } else if (*type == "sphere") {
         c.kind = ColliderSpec::Kind::Sphere;
         const std::optional<double> rad = r.number("radius");
@@ -530,7 +563,7 @@ class SceneParser {
         c.radius = r.requirePositive("radius", *rad) * mpu();
         only("normal", "planes");
         only("size", "boxes");
-        only("node", "meshes");
+        followNode("sphere");
       } else if (*type == "mesh") {
         c.kind = ColliderSpec::Kind::Mesh;
         const std::optional<std::string> node = r.string("node");
@@ -548,11 +581,68 @@ class SceneParser {
         r.fail("type",
                "unknown collider type '" + *type + "' (expected plane, box, sphere or mesh)");
       }
-      if (auto mu = r.number("friction")) c.friction = r.requireNonNegative("friction", *mu);
+      // Friction: an explicit `friction` wins, else the material's [friction]
+      // entry, else [friction] default.
+      const std::optional<std::string> material = r.string("material");
+      if (material && !isMaterialName(*material)) r.fail("material", notMaterialName(*material));
+      if (auto mu = r.number("friction")) {
+        c.friction = r.requireNonNegative("friction", *mu);
+        c.material = material.value_or("custom");
+      } else if (material) {
+        const auto it = spec_.friction.find(*material);
+        if (it == spec_.friction.end()) {
+          std::string known;
+          for (const auto& entry : spec_.friction)
+            known += (known.empty() ? "" : ", ") + entry.first;
+          r.fail("material", "material '" + *material +
+                                 "' has no coefficient: add it to [friction] (known: " + known +
+                                 ")");
+        }
+        c.friction = it->second;
+        c.material = *material;
+      } else {
+        c.friction = spec_.friction.at("default");
+        c.material = "default";
+      }
       c.name = r.string("name").value_or(c.node.empty() ? "collider" + std::to_string(i) : c.node);
       if (c.name.empty()) r.fail("name", "must not be empty");
       if (!names.insert(c.name).second) r.fail("name", "duplicate collider name '" + c.name + "'");
       spec_.colliders.push_back(std::move(c));
+    }
+  }
+
+  // [friction]: material name = Coulomb coefficient of paper on it, on top of
+  // the built-in default and paper (paper on paper).
+  void parseFriction(const toml::table* table) {
+    spec_.friction = {{"default", kDefaultFriction}, {"paper", kDefaultFriction}};
+    if (!table) return;
+    const TableReader r(*table, "friction", file_);
+    // Report the first bad entry in file order (toml++ sorts keys).
+    std::vector<std::pair<long, std::string>> keys;
+    for (auto&& [k, v] : *table)
+      keys.emplace_back(static_cast<long>(k.source().begin.line), std::string(k.str()));
+    std::sort(keys.begin(), keys.end());
+    for (const auto& [line, name] : keys) {
+      if (!isMaterialName(name)) r.fail(name, notMaterialName(name));
+      spec_.friction[name] = r.requireNonNegative(name, *r.number(name));
+    }
+  }
+
+  // [contact] self = true | false | "auto".
+  void parseContact(const toml::table* table) {
+    if (!table) return;
+    const TableReader r(*table, "contact", file_);
+    r.allowOnly({"self"});
+    const toml::node* self = r.find("self");
+    if (!self) return;
+    const std::string expected = "expected true, false or \"auto\"";
+    if (auto b = self->as_boolean()) {
+      spec_.contact.self = b->get() ? ContactSpec::Self::On : ContactSpec::Self::Off;
+    } else if (auto str = self->as_string()) {
+      if (str->get() != "auto") r.fail("self", expected + " (got \"" + str->get() + "\")");
+      spec_.contact.self = ContactSpec::Self::Auto;
+    } else {
+      r.fail("self", expected + ", got " + detail::typeName(*self));
     }
   }
 
@@ -762,6 +852,11 @@ void checkAnimationNodes(const SceneSpec& scene, const AnimationScene& animation
     const ColliderSpec& c = scene.colliders[i];
     if (c.node.empty()) continue;
     check(c.nodeLine, "colliders[" + std::to_string(i) + "].node", [&] {
+      if (c.kind != ColliderSpec::Kind::Mesh) {
+        // A box or sphere follows the node's transform: any node will do.
+        (void)animation.worldPose(c.node, 0.0);
+        return;
+      }
       const std::optional<ImportedMesh> m = animation.mesh(c.node);
       if (!m || m->triangles.empty())
         throw InputError(animation.file(), "node '" + c.node + "' holds no triangle mesh");

@@ -10,8 +10,6 @@
 
 namespace crumple::io::detail {
 
-namespace {
-
 const char* typeName(const toml::node& n) {
   switch (n.type()) {
     case toml::node_type::table:
@@ -36,6 +34,8 @@ const char* typeName(const toml::node& n) {
       return "nothing";
   }
 }
+
+namespace {
 
 long nodeLine(const toml::node& n) { return static_cast<long>(n.source().begin.line); }
 

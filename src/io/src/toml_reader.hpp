@@ -17,6 +17,9 @@ namespace crumple::io::detail {
 // "3.5", "1e-06": shortest round-trippable-enough form for messages.
 std::string formatNumber(double v);
 
+// "a string", "an integer", ...: a node's type for messages.
+const char* typeName(const toml::node& n);
+
 // Parse TOML text; a syntax error becomes InputError("FILE:LINE: ...").
 toml::table parseToml(std::string_view text, const std::string& sourceName);
 

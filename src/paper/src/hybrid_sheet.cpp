@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <deque>
+#include <limits>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -15,6 +16,8 @@
 #include "crumple/paper/boundary_curve.hpp"
 #include "crumple/paper/cone_fit.hpp"
 #include "crumple/paper/damage.hpp"
+#include "crumple/sim/colliders.hpp"
+#include "crumple/sim/self_contact.hpp"
 #include "region_tools.hpp"
 #include "step_trace.hpp"
 
@@ -59,6 +62,11 @@ void accumulate(HybridStepStats& total, const HybridStepStats& s) {
   total.ms.cones += s.ms.cones;
   total.ms.rebuild += s.ms.rebuild;
   total.ms.isometry += s.ms.isometry;
+  total.ms.contacts += s.ms.contacts;
+  total.ms.selfContacts += s.ms.selfContacts;
+  total.elastic.contactMs += s.elastic.contactMs;
+  total.elastic.selfContactMs += s.elastic.selfContactMs;
+  total.elastic.selfContactSteps += s.elastic.selfContactSteps;
   total.coneSegments = s.coneSegments;
   total.topologyChanged = total.topologyChanged || s.topologyChanged;
 }
@@ -77,7 +85,13 @@ struct HybridSheet::Impl {
   std::vector<Vec3> spVelocities;
   double paperLength = 0.0;
   std::function<void(const mesh::SheetMesh&, double)> onRebuild;
-  double time = 0.0;  // time S_G and S_P are at
+  double time = 0.0;            // time S_G and S_P are at
+  sim::ContactOptions contact;  // issue 5
+  std::vector<sim::ContactSample> contacts;
+  bool contactsOn() const {
+    return (contact.colliders != nullptr && contact.colliders->size() > 0) ||
+           contact.self != sim::SelfContactMode::Off;
+  }
   // Where compression was treated in the last remeshCooldown steps, and how
   // many more steps each point blocks remeshing of the region holding it.
   std::vector<std::pair<Vec2, int>> recentCuts;
@@ -104,6 +118,7 @@ struct HybridSheet::Impl {
     sp = std::move(next);
     if (!same) {
       elastic.emplace(sp.mesh, material, simParams);
+      elastic->setContacts(contact);
     } else {
       elastic->setPositions(sp.mesh.positions);
     }
@@ -138,6 +153,12 @@ struct HybridSheet::Impl {
                      int singularBudget, std::uint64_t& draw, HybridStepStats& stats,
                      const char*& stage);
 
+  // Contact failsafe after the isometry (issue 5), on S_P's free vertices.
+  void contactFailsafe(const std::vector<char>& pinned, std::vector<Vec3>& x, HybridStageTimes& ms);
+  // The elastic step's contacts, carried to the current S_P by pattern.
+  void carryContacts(const std::vector<sim::ContactSample>& samples,
+                     const std::vector<Vec2>& patternBefore);
+
   void checkInvariants(int frame, const char* stage) const {
     const std::string problem = validate(sg, params.theta0);
     if (!problem.empty()) throw NumericalError(stage, frame, "S_G invariant broken: " + problem);
@@ -162,6 +183,76 @@ struct HybridSheet::Impl {
     }
   }
 };
+
+void HybridSheet::Impl::contactFailsafe(const std::vector<char>& held, std::vector<Vec3>& x,
+                                        HybridStageTimes& ms) {
+  auto t0 = Clock::now();
+  const double dist = contact.distance;
+  const double minGap = (1.0 - sim::kContactFailsafeSlack) * dist;
+  if (contact.colliders != nullptr && contact.colliders->size() > 0) {
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      if (held[i] != 0) continue;
+      if (const auto c = contact.colliders->nearest(x[i], dist); c && c->distance < minGap)
+        x[i] += (dist - c->distance) * c->normal;
+    }
+  }
+  ms.contacts += msSince(t0);
+  t0 = Clock::now();
+  if (contact.self == sim::SelfContactMode::On ||
+      (contact.self == sim::SelfContactMode::Auto &&
+       sim::sheetIsFolded(sp.mesh.triangles, x, contact.foldSpread))) {
+    std::vector<char> free(x.size(), 0);
+    for (std::size_t i = 0; i < x.size(); ++i) free[i] = held[i] == 0 ? 1 : 0;
+    sim::SelfContactDetector detector(sp.mesh.triangles, sp.mesh.pattern, dist);
+    for (const sim::SelfContactPair& p : detector.find(x, dist, &free)) {
+      if (!(p.distance < minGap)) continue;
+      const auto& t = sp.mesh.triangles[static_cast<std::size_t>(p.triangle)];
+      Vec3 q = Vec3::Zero();
+      for (std::size_t k = 0; k < 3; ++k) q += p.weights[k] * x[static_cast<std::size_t>(t[k])];
+      x[static_cast<std::size_t>(p.vertex)] = q + dist * p.normal;
+    }
+  }
+  ms.selfContacts += msSince(t0);
+}
+
+void HybridSheet::Impl::carryContacts(const std::vector<sim::ContactSample>& samples,
+                                      const std::vector<Vec2>& patternBefore) {
+  contacts.clear();
+  const auto& pattern = sp.mesh.pattern;
+  for (const sim::ContactSample& s : samples) {
+    const Vec2& at = patternBefore[static_cast<std::size_t>(s.vertex)];
+    // The vertex at the same material point, else the nearest one.
+    std::size_t best = 0;
+    double bestDistance = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < pattern.size(); ++i) {
+      const double d = (pattern[i] - at).squaredNorm();
+      if (d < bestDistance) {
+        bestDistance = d;
+        best = i;
+        if (d == 0.0) break;
+      }
+    }
+    sim::ContactSample carried = s;
+    carried.vertex = static_cast<int>(best);
+    contacts.push_back(carried);
+  }
+  std::sort(contacts.begin(), contacts.end(),
+            [](const sim::ContactSample& l, const sim::ContactSample& r) {
+              return l.vertex != r.vertex ? l.vertex < r.vertex : l.collider < r.collider;
+            });
+  // Two samples carried onto one vertex: forces summed, the fastest slide.
+  std::vector<sim::ContactSample> merged;
+  for (const sim::ContactSample& s : contacts) {
+    if (!merged.empty() && merged.back().vertex == s.vertex &&
+        merged.back().collider == s.collider) {
+      merged.back().normalForce += s.normalForce;
+      merged.back().slideSpeed = std::max(merged.back().slideSpeed, s.slideSpeed);
+    } else {
+      merged.push_back(s);
+    }
+  }
+  contacts = std::move(merged);
+}
 
 HybridSheet::HybridSheet(GeometricMesh sg, const sim::Material& material,
                          const sim::SimParams& simParams, const CrumpleParams& params,
@@ -210,6 +301,15 @@ void HybridSheet::placeVertices(const std::vector<sim::Pin>& pins) {
 
 void HybridSheet::setTime(double t) { impl_->time = t; }
 
+void HybridSheet::setContacts(sim::ContactOptions options) {
+  Impl& m = *impl_;
+  m.elastic->setContacts(options);  // validates
+  m.contact = std::move(options);
+  m.contacts.clear();
+}
+
+const std::vector<sim::ContactSample>& HybridSheet::contacts() const { return impl_->contacts; }
+
 const GeometricMesh& HybridSheet::geometric() const { return impl_->sg; }
 const PhysicalMesh& HybridSheet::physical() const { return impl_->sp; }
 const CrumpleParams& HybridSheet::params() const { return impl_->params; }
@@ -254,6 +354,8 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
   }
   stats.ms.elastic = msSince(t0);
   m.noteHinge(0);
+  const std::vector<sim::ContactSample> elasticContacts = m.elastic->contacts();
+  const std::vector<Vec2> elasticPattern = m.sp.mesh.pattern;
   const std::vector<Vec3>& x = m.elastic->positions();
   const std::vector<Vec3>& v = m.elastic->velocities();
   // (c) S_P -> S_G.
@@ -389,6 +491,20 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
     stats.isometry.meanLengthErrorAfter = stats.isometry.meanLengthErrorBefore;
     stats.isometry.meanDisplacement = 0.0;
   }
+  stats.ms.isometry = msSince(t0);
+  if (m.contactsOn()) {
+    stage = "contacts";
+    std::vector<char> held(m.sp.mesh.vertexCount(), 0);
+    for (const sim::Pin& p : pinned)
+      if (static_cast<std::size_t>(p.vertex) < held.size())
+        held[static_cast<std::size_t>(p.vertex)] = 1;
+    m.contactFailsafe(held, positions, stats.ms);
+    const auto carryStart = Clock::now();
+    m.carryContacts(elasticContacts, elasticPattern);
+    stats.ms.contacts += msSince(carryStart);
+    stage = "isometry";
+  }
+  t0 = Clock::now();
   m.sp.mesh.positions = positions;
   for (std::size_t i = 0; i < m.sg.vertices.size(); ++i) m.sg.vertices[i].position = positions[i];
   m.elastic->setPositions(positions);
@@ -396,7 +512,7 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
   for (auto& cut : m.recentCuts) --cut.second;
   std::erase_if(m.recentCuts, [](const auto& cut) { return cut.second <= 0; });
   for (const Vec2& p : stats.geometric.cuts) m.recentCuts.emplace_back(p, m.params.remeshCooldown);
-  stats.ms.isometry = msSince(t0);
+  stats.ms.isometry += msSince(t0);
   if (m.traceLevel > 0) {
     std::vector<sim::Pin> pinned;
     pins(t + dt, pinned);

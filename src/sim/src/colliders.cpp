@@ -82,6 +82,7 @@ struct ColliderSet::Impl {
     std::string name;
     ColliderShape shape;
     Pose pose;
+    Pose previous;  // before the last setPose
     double friction = 0.0;
     std::shared_ptr<BvhModel> bvh;  // meshes only
   };
@@ -168,6 +169,7 @@ int ColliderSet::add(std::string name, ColliderShape shape, const Pose& pose, do
   c.shape = std::move(shape);
   c.pose = pose;
   c.pose.rotation.normalize();
+  c.previous = c.pose;
   impl_->colliders.push_back(std::move(c));
   return static_cast<int>(impl_->colliders.size()) - 1;
 }
@@ -179,8 +181,14 @@ void ColliderSet::setPose(int collider, const Pose& pose) {
       !(pose.rotation.norm() > 0.0))
     throw std::invalid_argument("ColliderSet::setPose: pose is not finite");
   auto& c = impl_->colliders[static_cast<std::size_t>(collider)];
+  c.previous = c.pose;
   c.pose = pose;
   c.pose.rotation.normalize();
+}
+
+Vec3 ColliderSet::surfaceDisplacement(int collider, const Vec3& p) const {
+  const auto& c = impl_->colliders.at(static_cast<std::size_t>(collider));
+  return p - toWorld(c.previous, toLocal(c.pose, p));
 }
 
 std::size_t ColliderSet::size() const { return impl_->colliders.size(); }

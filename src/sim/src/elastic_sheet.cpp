@@ -61,6 +61,7 @@
 #include <mutex>
 #include <numbers>
 #include <numeric>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -69,6 +70,7 @@
 #include "crumple/core/parallel.hpp"
 #include "crumple/sim/colliders.hpp"
 #include "crumple/sim/energies.hpp"
+#include "crumple/sim/self_contact.hpp"
 
 namespace crumple::sim {
 namespace {
@@ -138,10 +140,7 @@ using VecX = Eigen::VectorXd;
 // left by a force F is F h^2 / (kContactScale m), 1e-6 m for gravity at
 // h = 1/96 s, about 1 % of a sheet's thickness (issue 5).
 constexpr double kContactScale = 1000.0;
-// The failsafe projection acts on vertices the penalty left more than this
-// fraction of the contact distance too near (a penalty equilibrium is left
-// alone: its gap carries the normal force that friction needs).
-constexpr double kFailsafeSlack = 0.05;
+constexpr double kFailsafeSlack = kContactFailsafeSlack;
 // Below this tangential speed (m/s) friction acts as a stiff spring (static
 // friction, smoothed); above it, as Coulomb's constant force.
 constexpr double kFrictionSpeed = 1e-3;
@@ -222,19 +221,55 @@ struct ElasticSheet::Impl {
   std::vector<int> diagOffset;    // per free DOF
   std::vector<int> vertexOffset;  // 9 per free vertex: its 3x3 diagonal block (lower part), or -1
 
-  // Contacts (issue 5): the colliders the free vertices must keep `contactDistance` from.
-  const ColliderSet* colliders = nullptr;
-  double contactDistance = 0.0;
-  // Per step: each vertex's frozen contact plane (point, outward normal), if any.
+  // Contacts (issue 5): colliders and self-contact (setContacts).
+  ContactOptions contact;
+  std::vector<Vec2> pattern;                        // material coordinates, for self-contact
+  std::optional<SelfContactDetector> selfDetector;  // built on first use
+  // Per step: the frozen contact planes (a vertex may have several).
   struct ContactPlane {
     int vertex;
-    Vec3 point;
-    Vec3 normal;
+    int collider;   // ColliderSet index, -1 = the sheet itself
+    Vec3 point;     // on the touched surface, where it is at the end of the step
+    Vec3 normal;    // unit, out of the touched surface
+    Vec3 motion;    // the touched surface's displacement over the step
     double mu;      // Coulomb friction coefficient
     double lambda;  // lagged normal force (N) at the start of the step
+    double k;       // penalty stiffness (N/m)
+    // An edge or corner contact with another layer (SelfContactPair::face
+    // false) keeps the distance to that triangle, frozen where the layer's
+    // velocity carries it, rather than to a plane: a plane through an edge
+    // would stand in the way of vertices that pass the triangle by.
+    bool toTriangle = false;
+    std::array<Vec3, 3> triangle{};
+    // The penalty's gap (contact distance minus the distance) at x, and the
+    // direction it pushes along.
+    double gap(const Vec3& x, double distance, Vec3* direction) const {
+      if (!toTriangle) {
+        if (direction != nullptr) *direction = normal;
+        return distance - normal.dot(x - point);
+      }
+      const Vec3 d = x - closestPointOnTriangle(x, triangle[0], triangle[1], triangle[2]);
+      const double len = d.norm();
+      if (direction != nullptr) *direction = len > 0.0 ? Vec3(d / len) : normal;
+      return distance - len;
+    }
   };
   std::vector<ContactPlane> contactPlanes;
+  std::vector<SelfContactPair> selfPairs;  // this step's, for the failsafe
+  std::vector<ContactSample> lastContacts;
   long contactVertexSteps = 0;  // contacts found, summed over steps (statistics)
+  bool collidersOn() const { return contact.colliders != nullptr && contact.colliders->size() > 0; }
+  // The contact planes of a step from x_n (xn) to the predictor xk.
+  void findContacts(const std::vector<Vec3>& xn, const std::vector<Vec3>& xk, double h,
+                    StepStats& stats);
+  // Failsafe projection and the step's contact samples.
+  struct Pushed {
+    std::size_t vertex;
+    Vec3 normal;           // pushed out along
+    Vec3 surfaceVelocity;  // of the surface it was pushed out of
+  };
+  void resolveContacts(const std::vector<Vec3>& xn, std::vector<Vec3>& xk, double h,
+                       StepStats& stats, std::vector<Pushed>& pushed);
   Solver solver;
   int analyzeCount = 0;
   bool supernodal = false;  // which CHOLMOD factorisation the last analysis chose
@@ -303,6 +338,7 @@ ElasticSheet::Impl::Impl(const mesh::SheetMesh& m, const Material& material, con
   bendingRigidity = material.bendingStiffness();
   vertexCount = m.vertexCount();
   triangles = m.triangles;
+  pattern = m.pattern;
   x = m.positions;
   v.assign(vertexCount, Vec3::Zero());
 
@@ -576,9 +612,182 @@ void ElasticSheet::Impl::evaluateEnergies(const std::vector<Vec3>& xs) {
 
 // One backward Euler step from the current state at t0 to t1.
 // On failure returns false with a reason and leaves the state untouched.
+// Contacts (issue 5; paper Sec. 4): a free vertex that may come within the
+// contact distance D of a collider, or of another layer of the sheet, during
+// the step gets that surface's tangent plane (point p, outward normal m) at
+// the start of the step, frozen for the step, and the penalty
+// k/2 max(0, D - m.(x - p))^2 with k = kContactScale * mass / h^2 (a stiff
+// spring on the inertia's scale). A collider's plane is taken where the
+// collider ends the step; a layer's where its velocity carries it (each side
+// of a self-contact sees the other one frozen: a Jacobi split that keeps the
+// system's sparsity, the reaction reaching the other layer through its own
+// vertices' contacts). resolveContacts is the failsafe.
+void ElasticSheet::Impl::findContacts(const std::vector<Vec3>& xn, const std::vector<Vec3>& xk,
+                                      double h, StepStats& stats) {
+  using Clock = std::chrono::steady_clock;
+  const auto since = [](Clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+  };
+  contactPlanes.clear();
+  selfPairs.clear();
+  const double dist = contact.distance;
+  if (collidersOn()) {
+    const auto start = Clock::now();
+    const ColliderSet& set = *contact.colliders;
+    for (std::size_t i = 0; i < vertexCount; ++i) {
+      if (freeIndex[i] < 0) continue;
+      const double reach = 2.0 * dist + (xk[i] - xn[i]).norm();
+      if (const auto c = set.nearest(xn[i], reach)) {
+        const double k = kContactScale * mass[i] / (h * h);
+        // The normal force the penalty exerted at x_n, lagged for friction.
+        const double lambda = k * std::max(0.0, dist - c->distance);
+        contactPlanes.push_back({static_cast<int>(i), c->collider, c->point, c->normal,
+                                 set.surfaceDisplacement(c->collider, c->point),
+                                 set.friction(c->collider), lambda, k});
+      }
+    }
+    stats.contactMs += since(start);
+  }
+  if (contact.self != SelfContactMode::Off) {
+    const auto start = Clock::now();
+    if (contact.self == SelfContactMode::On || sheetIsFolded(triangles, xn, contact.foldSpread)) {
+      ++stats.selfContactSteps;
+      // Pairs that may come within 2 D over the predicted move.
+      if (!selfDetector) selfDetector.emplace(triangles, pattern, dist);
+      std::vector<char> mask(vertexCount, 0);
+      for (std::size_t i = 0; i < vertexCount; ++i) mask[i] = freeIndex[i] >= 0 ? 1 : 0;
+      selfPairs = selfDetector->find(xn, xk, 2.0 * dist, &mask);
+      for (const SelfContactPair& p : selfPairs) {
+        const auto& t = triangles[static_cast<std::size_t>(p.triangle)];
+        Vec3 at = Vec3::Zero(), motion = Vec3::Zero();
+        for (std::size_t a = 0; a < 3; ++a) {
+          const auto j = static_cast<std::size_t>(t[a]);
+          at += p.weights[a] * xn[j];
+          motion += p.weights[a] * (xk[j] - xn[j]);  // the predictor: x_n + h v_n, or the pin
+        }
+        const auto vi = static_cast<std::size_t>(p.vertex);
+        const double k = kContactScale * mass[vi] / (h * h);
+        ContactPlane plane{p.vertex,
+                           -1,
+                           at + motion,
+                           p.normal,
+                           motion,
+                           contact.selfFriction,
+                           k * std::max(0.0, dist - p.distance),
+                           k};
+        if (!p.face) {
+          plane.toTriangle = true;
+          for (std::size_t a = 0; a < 3; ++a)
+            plane.triangle[a] = xk[static_cast<std::size_t>(t[a])];
+        }
+        contactPlanes.push_back(plane);
+      }
+    }
+    stats.selfContactMs += since(start);
+  }
+  contactVertexSteps += static_cast<long>(contactPlanes.size());
+}
+
+// Failsafe: a free vertex the penalty left nearer than (1 - slack) D to a
+// collider (a contact the frozen plane missed), or nearer than that to a
+// triangle of another layer or through it, is moved out to D, and loses its
+// velocity into that surface (pushed). Then the step's contact samples:
+// every plane whose penalty is active at the solution, or whose vertex was
+// pushed, merged per (vertex, collider).
+void ElasticSheet::Impl::resolveContacts(const std::vector<Vec3>& xn, std::vector<Vec3>& xk,
+                                         double h, StepStats& stats, std::vector<Pushed>& pushed) {
+  using Clock = std::chrono::steady_clock;
+  const auto since = [](Clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+  };
+  const double dist = contact.distance;
+  const double minGap = (1.0 - kFailsafeSlack) * dist;
+  // Samples from the solution the penalty reached (before any projection).
+  std::vector<ContactSample> samples;
+  for (const auto& cp : contactPlanes) {
+    const auto vi = static_cast<std::size_t>(cp.vertex);
+    const double gap = cp.gap(xk[vi], dist, nullptr);
+    if (!(gap > 0.0)) continue;
+    const Mat3 t = Mat3::Identity() - cp.normal * cp.normal.transpose();
+    samples.push_back(
+        {cp.vertex, cp.collider, (t * ((xk[vi] - xn[vi]) - cp.motion)).norm() / h, cp.k * gap});
+  }
+  if (collidersOn()) {
+    const auto start = Clock::now();
+    const ColliderSet& set = *contact.colliders;
+    for (std::size_t i = 0; i < vertexCount; ++i) {
+      if (freeIndex[i] < 0) continue;
+      if (const auto c = set.nearest(xk[i], dist); c && c->distance < minGap) {
+        const Vec3 surfaceVelocity = set.surfaceDisplacement(c->collider, c->point) / h;
+        samples.push_back({static_cast<int>(i), c->collider,
+                           ((Mat3::Identity() - c->normal * c->normal.transpose()) *
+                            ((xk[i] - xn[i]) / h - surfaceVelocity))
+                               .norm(),
+                           kContactScale * mass[i] / (h * h) * (dist - c->distance)});
+        xk[i] += (dist - c->distance) * c->normal;
+        pushed.push_back({i, c->normal, surfaceVelocity});
+      }
+    }
+    stats.contactMs += since(start);
+  }
+  if (!selfPairs.empty()) {
+    const auto start = Clock::now();
+    for (const SelfContactPair& p : selfPairs) {
+      const auto vi = static_cast<std::size_t>(p.vertex);
+      const auto& t = triangles[static_cast<std::size_t>(p.triangle)];
+      const Vec3& a = xk[static_cast<std::size_t>(t[0])];
+      const Vec3& b = xk[static_cast<std::size_t>(t[1])];
+      const Vec3& c = xk[static_cast<std::size_t>(t[2])];
+      const Vec3 q = closestPointOnTriangle(xk[vi], a, b, c);
+      const Vec3 d = xk[vi] - q;
+      const double gap = d.norm();
+      const double side = d.dot(p.normal);
+      // Through the triangle: the closest point is inside it and the vertex
+      // is on the other side of where it started.
+      const Vec3 face = (b - a).cross(c - a);
+      const bool inside =
+          face.norm() > 0.0 && std::abs(d.normalized().dot(face.normalized())) > 1.0 - 1e-9;
+      const bool through = side < 0.0 && inside;
+      if (gap >= minGap && !through) continue;
+      const Vec3 out = (side >= 0.0 && gap > 1e-9 * dist) ? Vec3(d / gap) : p.normal;
+      Vec3 surfaceVelocity = Vec3::Zero();
+      for (std::size_t k = 0; k < 3; ++k) {
+        const auto j = static_cast<std::size_t>(t[k]);
+        surfaceVelocity += p.weights[k] * (xk[j] - xn[j]) / h;
+      }
+      samples.push_back(
+          {p.vertex, -1,
+           ((Mat3::Identity() - out * out.transpose()) * ((xk[vi] - xn[vi]) / h - surfaceVelocity))
+               .norm(),
+           kContactScale * mass[vi] / (h * h) * std::max(0.0, dist - gap)});
+      xk[vi] = q + dist * out;
+      pushed.push_back({vi, out, surfaceVelocity});
+    }
+    stats.selfContactMs += since(start);
+  }
+  // One sample per (vertex, collider): forces summed, the fastest slide.
+  std::sort(samples.begin(), samples.end(), [](const ContactSample& l, const ContactSample& r) {
+    return l.vertex != r.vertex ? l.vertex < r.vertex : l.collider < r.collider;
+  });
+  for (const ContactSample& sample : samples) {
+    if (!lastContacts.empty() && lastContacts.back().vertex == sample.vertex &&
+        lastContacts.back().collider == sample.collider) {
+      lastContacts.back().normalForce += sample.normalForce;
+      lastContacts.back().slideSpeed = std::max(lastContacts.back().slideSpeed, sample.slideSpeed);
+    } else {
+      lastContacts.push_back(sample);
+    }
+  }
+}
+
 bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, StepStats& stats,
                                  std::string& why) {
   const double h = t1 - t0;
+  // Animated colliders: where the step begins, then where it ends.
+  if (collidersOn() && contact.moveColliders) {
+    contact.moveColliders(t0);
+    contact.moveColliders(t1);
+  }
   // Handle targets at t1 (paper Sec. 4: handles are hard constraints).
   pinBuffer.clear();
   if (pins) pins(t1, pinBuffer);
@@ -635,33 +844,7 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
 
   const double massDiag = 1.0 / (h * h) + alpha / h;
 
-  // Contacts (issue 5; paper Sec. 4): a free vertex that may come within the
-  // contact distance D of a collider during the step gets the collider's
-  // tangent plane (point p, outward normal m) at the start of the step,
-  // frozen for the step, and the penalty k/2 max(0, D - m.(x - p))^2 with
-  // k = kContactScale * mass / h^2 (a stiff spring on the inertia's scale).
-  // A projection after the solve is the failsafe (contactFailsafe).
-  contactPlanes.clear();
-  std::vector<double> contactK;
-  const auto contactStart = std::chrono::steady_clock::now();
-  if (colliders != nullptr && colliders->size() > 0) {
-    for (std::size_t i = 0; i < nv; ++i) {
-      if (freeIndex[i] < 0) continue;
-      const double reach = 2.0 * contactDistance + (xk[i] - xn[i]).norm();
-      if (const auto c = colliders->nearest(xn[i], reach)) {
-        const double k = kContactScale * mass[i] / (h * h);
-        // The normal force the penalty exerted at x_n, lagged for friction.
-        const double lambda = k * std::max(0.0, contactDistance - c->distance);
-        contactPlanes.push_back(
-            {static_cast<int>(i), c->point, c->normal, colliders->friction(c->collider), lambda});
-        contactK.push_back(k);
-      }
-    }
-    contactVertexSteps += static_cast<long>(contactPlanes.size());
-    stats.contactMs +=
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - contactStart)
-            .count();
-  }
+  findContacts(xn, xk, h, stats);
   // Coulomb friction with the lagged normal force (IPC's smoothed friction
   // potential, Li et al. 2020, Sec. 5): the tangential displacement over the
   // step u = T (x - x_n) costs mu lambda f0(|u|), where f0 is |u| beyond
@@ -673,7 +856,7 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
                            Mat3* hess) {
     if (!(cp.mu > 0.0) || !(cp.lambda > 0.0)) return 0.0;
     const Mat3 t = Mat3::Identity() - cp.normal * cp.normal.transpose();
-    const Vec3 u = t * (xi - xni);
+    const Vec3 u = t * ((xi - xni) - cp.motion);
     const double y = u.norm();
     const double scale = cp.mu * cp.lambda;
     const double f0 = y >= eps ? y : -y * y * y / (3.0 * eps * eps) + y * y / eps + eps / 3.0;
@@ -695,11 +878,10 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
   // Penalty and friction energy of the contacts at xs.
   auto contactEnergy = [&](const std::vector<Vec3>& xs) {
     double e = 0.0;
-    for (std::size_t c = 0; c < contactPlanes.size(); ++c) {
-      const auto& cp = contactPlanes[c];
+    for (const auto& cp : contactPlanes) {
       const auto vi = static_cast<std::size_t>(cp.vertex);
-      const double gap = contactDistance - cp.normal.dot(xs[vi] - cp.point);
-      if (gap > 0.0) e += 0.5 * contactK[c] * gap * gap;
+      const double gap = cp.gap(xs[vi], contact.distance, nullptr);
+      if (gap > 0.0) e += 0.5 * cp.k * gap * gap;
       e += frictionTerms(cp, xs[vi], xn[vi], nullptr, nullptr);
     }
     return e;
@@ -734,11 +916,11 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
     }
     scatterVectors(triangles, triGrad, freeIndex, 1.0, gradV);
     scatterVectors(hingeVertices, hingeGrad, freeIndex, 1.0, gradV);
-    for (std::size_t c = 0; c < contactPlanes.size(); ++c) {
-      const auto& cp = contactPlanes[c];
+    for (const auto& cp : contactPlanes) {
       const auto vi = static_cast<std::size_t>(cp.vertex);
-      const double gap = contactDistance - cp.normal.dot(xk[vi] - cp.point);
-      if (gap > 0.0) gradV.segment<3>(3 * freeIndex[vi]) -= contactK[c] * gap * cp.normal;
+      Vec3 n;
+      const double gap = cp.gap(xk[vi], contact.distance, &n);
+      if (gap > 0.0) gradV.segment<3>(3 * freeIndex[vi]) -= cp.k * gap * n;
       Vec3 g = Vec3::Zero();
       frictionTerms(cp, xk[vi], xn[vi], &g, nullptr);
       gradV.segment<3>(3 * freeIndex[vi]) += g;
@@ -762,12 +944,13 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
       }
       scatterBlocks(triHess, beta > 0.0 ? &triDamp : nullptr, dampScale, triOffset, values);
       scatterBlocks(hingeHess, beta > 0.0 ? &hingeDamp : nullptr, dampScale, hingeOffset, values);
-      for (std::size_t c = 0; c < contactPlanes.size(); ++c) {
-        const auto& cp = contactPlanes[c];
+      for (const auto& cp : contactPlanes) {
         const auto vi = static_cast<std::size_t>(cp.vertex);
         Mat3 block = Mat3::Zero();
-        if (contactDistance - cp.normal.dot(xk[vi] - cp.point) > 0.0)
-          block += contactK[c] * cp.normal * cp.normal.transpose();
+        // Gauss-Newton for a triangle's distance: the curvature term of
+        // |x - q| is left out (it would make the block indefinite).
+        Vec3 n;
+        if (cp.gap(xk[vi], contact.distance, &n) > 0.0) block += cp.k * n * n.transpose();
         Vec3 g;
         Mat3 hf = Mat3::Zero();
         frictionTerms(cp, xk[vi], xn[vi], &g, &hf);
@@ -900,29 +1083,17 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
     why = "non-finite positions";
     return false;
   }
-  // Failsafe: a free vertex still nearer than (1 - slack) D to a collider (a
-  // contact the frozen plane missed) is moved out to D along the collider's
-  // normal, and its velocity loses the part that points into the collider.
-  std::vector<std::pair<std::size_t, Vec3>> pushed;
-  if (colliders != nullptr && colliders->size() > 0) {
-    const auto failsafeStart = std::chrono::steady_clock::now();
-    for (std::size_t i = 0; i < nv; ++i) {
-      if (freeIndex[i] < 0) continue;
-      if (const auto c = colliders->nearest(xk[i], contactDistance);
-          c && c->distance < (1.0 - kFailsafeSlack) * contactDistance) {
-        xk[i] += (contactDistance - c->distance) * c->normal;
-        pushed.emplace_back(i, c->normal);
-      }
-    }
-    stats.contactMs +=
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - failsafeStart)
-            .count();
-  }
+  std::vector<Pushed> pushed;
+  lastContacts.clear();
+  if (!contactPlanes.empty() || collidersOn()) resolveContacts(xn, xk, h, stats, pushed);
   for (std::size_t i = 0; i < nv; ++i) {
     v[i] = (xk[i] - xn[i]) / h;
     x[i] = xk[i];
   }
-  for (const auto& [i, m] : pushed) v[i] -= std::min(0.0, v[i].dot(m)) * m;
+  // A pushed vertex keeps no velocity into the surface it was pushed out of
+  // (relative to that surface's own velocity).
+  for (const Pushed& p : pushed)
+    v[p.vertex] -= std::min(0.0, (v[p.vertex] - p.surfaceVelocity).dot(p.normal)) * p.normal;
   trackBranches(x);
   return true;
 }
@@ -998,14 +1169,23 @@ StepStats ElasticSheet::advance(double t, double dt, const PinFunction& pins) {
   return stats;
 }
 
-void ElasticSheet::setColliders(const ColliderSet* colliders, double contactDistance) {
-  if (colliders != nullptr && !(contactDistance > 0.0 && std::isfinite(contactDistance)))
-    throw std::invalid_argument("ElasticSheet::setColliders: contact distance must be > 0");
-  impl_->colliders = colliders;
-  impl_->contactDistance = contactDistance;
+void ElasticSheet::setContacts(ContactOptions options) {
+  const bool any = (options.colliders != nullptr && options.colliders->size() > 0) ||
+                   options.self != SelfContactMode::Off;
+  if (any && !(options.distance > 0.0 && std::isfinite(options.distance)))
+    throw std::invalid_argument("ElasticSheet::setContacts: contact distance must be > 0");
+  if (!(options.selfFriction >= 0.0) || !std::isfinite(options.selfFriction))
+    throw std::invalid_argument("ElasticSheet::setContacts: friction must be finite and >= 0");
+  if (!(options.foldSpread > 0.0) || !std::isfinite(options.foldSpread))
+    throw std::invalid_argument("ElasticSheet::setContacts: fold spread must be > 0");
+  if (impl_->selfDetector && options.distance != impl_->contact.distance)
+    impl_->selfDetector.reset();
+  impl_->contact = std::move(options);
+  impl_->lastContacts.clear();
 }
 
 long ElasticSheet::contactVertexSteps() const { return impl_->contactVertexSteps; }
+const std::vector<ContactSample>& ElasticSheet::contacts() const { return impl_->lastContacts; }
 
 const std::vector<Vec3>& ElasticSheet::positions() const { return impl_->x; }
 const std::vector<Vec3>& ElasticSheet::velocities() const { return impl_->v; }

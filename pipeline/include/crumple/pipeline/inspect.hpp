@@ -1,7 +1,8 @@
 #pragma once
 // Per-frame measures of a cached shot (`crumple inspect`): sizes, edge strain
 // against the pattern (c_mean and n_comp as in paper Table IV), sharpest
-// fold between adjacent triangles, handle error.
+// fold between adjacent triangles, handle error, contacts (the COLL / CONT
+// sub-blocks, exporters/pcache_contacts.hpp).
 #include <string>
 #include <vector>
 
@@ -22,14 +23,20 @@ struct FrameMetrics {
   std::size_t singularVertices = 0;
   std::size_t junctionVertices = 0;
   std::size_t tears = 0;
+  std::size_t contacts = 0;    // records in the frame's CONT block (0 without one)
+  double maxSlideSpeed = 0.0;  // largest slide speed among them (m/s)
 };
 
+// Throws CorruptDataError naming the frame for a malformed CONT block.
 FrameMetrics measureFrame(const cache::FrameRecord& frame);
 
 // The `inspect --json` object: {"format_version", "fps", "frame_count",
-// "frames": [...]} -- later features extend it but never rename a key.
+// "frames": [...]} -- later features extend it but never rename a key. A
+// cache whose header has COLL adds "colliders": [{"name", "material",
+// "friction"}] and, per frame, "contacts" and "max_slide_speed" (m/s).
 std::string inspectJson(const cache::CacheReader& reader);
-// The human-readable table.
+// The human-readable table (with the colliders and a contacts and a max
+// slide speed column when the header has COLL).
 std::string inspectText(const cache::CacheReader& reader);
 
 }  // namespace crumple::pipeline

@@ -67,9 +67,22 @@ struct ShotReport {
   long newtonIterations = 0;
   long substeps = 0;
   long halvings = 0;
-  long elasticRetries = 0;
-  double contactMs = 0.0;  // contact detection and failsafe, within the elastic stage  // hybrid:
-                           // elastic steps retried with the pins on their targets
+  long elasticRetries = 0;  // hybrid: elastic steps retried with the pins on their targets
+  // Contacts (issue 5): collider and self-contact work (detection, the
+  // failsafe; within the elastic stage, plus the crumpling model's failsafe
+  // after its isometry), the deepest free vertex inside a collider or the
+  // sheet at any frame (in thicknesses), and the contacts written to the cache.
+  bool contactsOn = false;
+  std::string selfContactMode;  // "on", "off" or "auto"
+  double contactMs = 0.0;
+  double selfContactMs = 0.0;
+  long selfContactSteps = 0;  // substeps self-contact detection ran in
+  double maxContactDepth = 0.0;
+  int maxContactDepthFrame = 0;
+  long contactSamples = 0;
+  // The contacts' share of the simulation step (elastic, geometric, cones,
+  // rebuild, isometry and contact stages).
+  double contactShareOfStep() const;
   std::size_t vertices = 0;
   std::size_t triangles = 0;
   double maxHandleError = 0.0;

@@ -4,6 +4,7 @@
 // radians. Unknown keys and bad values throw crumple::InputError naming the
 // file, the line and the key (DESIGN.md "Invariants").
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -116,20 +117,39 @@ struct PropSpec {
 };
 
 // A collider the sheet must stay outside of (issue 5). Plane: the solid half
-// below `position` along -normal; box: axis-aligned, centred on `position`;
-// sphere: centred on `position`; mesh: the triangles of an animation-file
-// node, moving with the node.
+// below `position` along -normal; box: centred on `position`, axis-aligned
+// (without a node); sphere: centred on `position`; mesh: the triangles of an
+// animation-file node, moving with the node.
+// A box or sphere with a `node` follows that node (any node, e.g. a finger;
+// it need not hold a mesh): `position` is then an offset in the node's local
+// frame and the solid moves rigidly with the node's world pose (position and
+// rotation; a box's axes turn with the node).
 struct ColliderSpec {
   enum class Kind { Plane, Box, Sphere, Mesh };
   std::string name;
   Kind kind = Kind::Plane;
-  Vec3 position = Vec3::Zero();     // m
+  Vec3 position = Vec3::Zero();     // m; world, or the node's local frame when `node` is set
   Vec3 normal = Vec3::UnitY();      // plane (unit)
   Vec3 size = Vec3::Constant(0.1);  // m, box side lengths
   double radius = 0.05;             // m, sphere
-  double friction = 0.3;            // Coulomb coefficient of paper on this collider
-  std::string node;                 // mesh
-  long nodeLine = 0;
+  // Coulomb coefficient of paper on this collider, resolved on parse: an
+  // explicit `friction` key, else SceneSpec::friction[material].
+  double friction = 0.3;
+  // The [friction] entry this collider is made of: "default" when the scene
+  // gives neither material nor friction, "custom" for an explicit friction
+  // without a material (with both, the name is kept and friction wins).
+  std::string material = "default";
+  std::string node;   // mesh (required), box and sphere (optional): animation-file node
+  long nodeLine = 0;  // scene file line of `node` (for errors)
+};
+
+// [contact]: how the sheet meets itself (issue 5).
+struct ContactSpec {
+  // Self-contact of the sheet. Auto: tested only while the sheet is folded
+  // (its triangle normals spread more than 60 degrees from their mean); On:
+  // at every step; Off: never.
+  enum class Self { Off, On, Auto };
+  Self self = Self::Auto;
 };
 
 struct GroundSpec {
@@ -202,6 +222,12 @@ struct SceneSpec {
   PaperLookSpec look;  // [paper] texture, texture_size, transmittance, crease_deg
   std::vector<PropSpec> props;
   std::vector<ColliderSpec> colliders;  // [[colliders]]: contacts run only when there are some
+  // [friction]: Coulomb coefficients of paper on named materials (material
+  // name -> mu >= 0). Always holds "default" (a collider without material or
+  // friction) and "paper" (paper on paper, used by self-contact), 0.3 each
+  // unless the scene overrides them; the scene may add more ("wood", ...).
+  std::map<std::string, double> friction;
+  ContactSpec contact;  // [contact]
   OutputSpec output;
   SimSpec sim;
   ModelSpec model;
@@ -225,8 +251,9 @@ std::string resolveScenePath(const std::string& sceneOrFolder);
 
 class AnimationScene;
 // Check that every node the scene names exists in the loaded animation file:
-// handle nodes, the camera node (which must hold a camera) and the pattern
-// mesh (which must hold triangles). Throws InputError at the scene file's
+// handle nodes, the camera node (which must hold a camera), the pattern mesh
+// and mesh colliders and props (which must hold triangles), and the nodes box
+// and sphere colliders follow (any node). Throws InputError at the scene file's
 // line, e.g. "scene.toml:12: 'handles[0].node': drape.glb: no node named ...".
 void checkAnimationNodes(const SceneSpec& scene, const AnimationScene& animation);
 

@@ -26,6 +26,10 @@ struct HybridStageTimes {
   double cones = 0.0;      // generalized-cone fitting (paper Sec. 6.2)
   double rebuild = 0.0;    // S_P from S_G, fiber damage, elastic-model setup
   double isometry = 0.0;   // paper Sec. 6.3
+  // The contact failsafe after the isometry (issue 5): against colliders,
+  // and self-contact (with carrying the contact set over to S_P).
+  double contacts = 0.0;
+  double selfContacts = 0.0;
 };
 
 struct HybridStepStats {
@@ -64,6 +68,17 @@ class HybridSheet {
   // rebuilt, before pins are asked for again (the handle rig re-chooses its
   // tangent-plane vertices there).
   void setRebuildCallback(std::function<void(const mesh::SheetMesh&, double t)> callback);
+
+  // Contacts (issue 5): the elastic step of every animation step takes them
+  // (sim::ElasticSheet::setContacts), and after the isometry projection a
+  // failsafe moves free S_P vertices nearer than 0.95 distance to a collider
+  // or to another layer of the sheet back out to the distance. Off by
+  // default.
+  void setContacts(sim::ContactOptions options);
+  // The contacts at the end of the last animation step, on the current S_P
+  // (the elastic step's contacts carried over to the rebuilt S_P by their
+  // pattern coordinates), sorted by (vertex, collider).
+  const std::vector<sim::ContactSample>& contacts() const;
 
   // Moves pinned vertices (S_G or S_P indices) to the given positions before
   // the first step (handles snapping onto their tracks) and re-interpolates

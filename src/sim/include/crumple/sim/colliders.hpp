@@ -52,7 +52,12 @@ class ColliderSet {
   int add(std::string name, ColliderShape shape, const Pose& pose, double friction = 0.0);
   double friction(int collider) const;
   // Moves an (animated) collider; its BVH is kept, only the pose changes.
+  // The pose it had before is kept for surfaceDisplacement().
   void setPose(int collider, const Pose& pose);
+  // How far the collider's material point now at world point p moved with
+  // the last setPose (zero for a collider never moved): the motion of the
+  // surface a vertex slides on, for friction against animated colliders.
+  Vec3 surfaceDisplacement(int collider, const Vec3& p) const;
   std::size_t size() const;
   const std::string& name(int collider) const;
 

@@ -52,7 +52,44 @@ struct StepStats {
   int halvings = 0;          // how many times a step was split
   int solves = 0;            // Cholesky factorisations
   double finalStepNorm = 0.0;
-  double contactMs = 0.0;  // wall time of contact detection and the failsafe (timing only)
+  double contactMs = 0.0;      // collider detection and failsafe, wall time (timing only)
+  double selfContactMs = 0.0;  // self-contact gate, detection and failsafe (timing only)
+  int selfContactSteps = 0;    // (sub)steps in which self-contact detection ran
+};
+
+// The contact failsafe projection acts on vertices the penalty left more
+// than this fraction of the contact distance too near (a penalty equilibrium
+// is left alone: its gap carries the normal force that friction needs).
+inline constexpr double kContactFailsafeSlack = 0.05;
+
+// Self-contact of the sheet (issue 5): never, at every step, or only while
+// the sheet is folded (sheetIsFolded with ContactOptions::foldSpread).
+enum class SelfContactMode { Off, On, Auto };
+
+// Contacts of the elastic step (issue 5; paper Sec. 4).
+struct ContactOptions {
+  // Colliders the free vertices keep `distance` from (not owned; must
+  // outlive the sheet or the next setContacts). Null or empty: none.
+  const ColliderSet* colliders = nullptr;
+  // Moves animated colliders to time t. Called with the start and then the
+  // end time of every (sub)step taken, halved ones included, so the
+  // colliders are where the step ends and remember where it began
+  // (ColliderSet::surfaceDisplacement, friction on moving surfaces). Empty:
+  // the colliders do not move.
+  std::function<void(double t)> moveColliders;
+  double distance = 0.0;  // contact distance (m, > 0): the paper's thickness
+  SelfContactMode self = SelfContactMode::Off;
+  double selfFriction = 0.3;               // Coulomb coefficient of paper on paper
+  double foldSpread = 1.0471975511965976;  // rad (60 deg): the Auto gate
+};
+
+// A vertex touching something at the end of a step (issue 5, item 5: what
+// the sound module hears).
+struct ContactSample {
+  int vertex = -1;
+  int collider = -1;         // ColliderSet index, or -1 for the sheet itself
+  double slideSpeed = 0.0;   // m/s, tangential, relative to the touched surface
+  double normalForce = 0.0;  // N, the contact's penalty force
 };
 
 class ElasticSheet {
@@ -77,16 +114,21 @@ class ElasticSheet {
   // (stage "elastic") and leaves the state as it was before the call.
   StepStats advance(double t, double dt, const PinFunction& pins);
 
-  // Contacts (issue 5): free vertices keep `contactDistance` (m, > 0; the
-  // paper's thickness) from every collider of the set: a penalty on frozen
-  // tangent planes in the implicit step, then a projection failsafe, so that
-  // no free vertex ends a step nearer than contactDistance. The set is not
-  // owned and must outlive the sheet or the next call; the caller moves
-  // animated colliders before each advance(). nullptr switches contacts off
-  // (the default: a scene without colliders pays nothing).
-  void setColliders(const ColliderSet* colliders, double contactDistance);
+  // Contacts (issue 5): free vertices keep options.distance from every
+  // collider and, with self-contact, from the triangles of other layers of
+  // the sheet: a penalty on tangent planes frozen at the start of the step
+  // (each layer sees the other where its velocity carries it), Coulomb
+  // friction relative to the touched surface, then a projection failsafe,
+  // so that no free vertex ends a step nearer than 0.95 distance. Without
+  // colliders and with self-contact off (the default) a step does no contact
+  // work at all. Throws std::invalid_argument for a distance <= 0 when any
+  // contact is on, or a negative friction.
+  void setContacts(ContactOptions options);
   // Vertex-steps with a contact plane since construction (statistics).
   long contactVertexSteps() const;
+  // The contacts at the end of the last accepted (sub)step, sorted by
+  // (vertex, collider), one per pair (forces summed, the fastest slide).
+  const std::vector<ContactSample>& contacts() const;
 
   const std::vector<Vec3>& positions() const;
   const std::vector<Vec3>& velocities() const;

@@ -1,0 +1,258 @@
+#include "crumple/sim/self_contact.hpp"
+
+#include <fcl/fcl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+#include <utility>
+
+namespace crumple::sim {
+
+namespace {
+
+// Barycentric coordinates of the point of triangle (a, b, c) closest to p
+// (Ericson, Real-Time Collision Detection, 5.1.5, with the weights kept).
+std::array<double, 3> closestBarycentric(const Vec3& p, const Vec3& a, const Vec3& b,
+                                         const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return {1.0, 0.0, 0.0};
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.0 && d4 <= d3) return {0.0, 1.0, 0.0};
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+    const double s = d1 / (d1 - d3);
+    return {1.0 - s, s, 0.0};
+  }
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.0 && d5 <= d6) return {0.0, 0.0, 1.0};
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+    const double s = d2 / (d2 - d6);
+    return {1.0 - s, 0.0, s};
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+    const double s = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {0.0, 1.0 - s, s};
+  }
+  const double denom = va + vb + vc;
+  if (!(std::abs(denom) > 0.0)) return {1.0, 0.0, 0.0};  // degenerate triangle
+  const double v = vb / denom, w = vc / denom;
+  return {1.0 - v - w, v, w};
+}
+
+Vec3 lift(const Vec2& p) { return {p.x(), p.y(), 0.0}; }
+
+bool shareVertex(const std::array<int, 3>& a, const std::array<int, 3>& b) {
+  for (int i : a)
+    for (int j : b)
+      if (i == j) return true;
+  return false;
+}
+
+// The broad phase's callback: records triangle pairs whose grown boxes
+// overlap and that share no vertex.
+struct BroadPhaseData {
+  const std::vector<std::array<int, 3>>* triangles = nullptr;
+  std::vector<std::pair<int, int>> pairs;
+};
+
+bool recordPair(fcl::CollisionObjectd* a, fcl::CollisionObjectd* b, void* data) {
+  auto* d = static_cast<BroadPhaseData*>(data);
+  const auto ta = static_cast<int>(reinterpret_cast<std::intptr_t>(a->getUserData()));
+  const auto tb = static_cast<int>(reinterpret_cast<std::intptr_t>(b->getUserData()));
+  const auto& tris = *d->triangles;
+  if (!shareVertex(tris[static_cast<std::size_t>(ta)], tris[static_cast<std::size_t>(tb)]))
+    d->pairs.emplace_back(std::min(ta, tb), std::max(ta, tb));
+  return false;  // never stop early: every pair is wanted
+}
+
+}  // namespace
+
+struct SelfContactDetector::Impl {
+  std::vector<std::array<int, 3>> triangles;
+  std::vector<Vec2> pattern;
+  double contactDistance = 0.0;
+  std::vector<std::shared_ptr<fcl::Boxd>> boxes;
+  std::vector<std::unique_ptr<fcl::CollisionObjectd>> objects;
+  std::unique_ptr<fcl::DynamicAABBTreeCollisionManagerd> manager;
+  std::size_t lastPairs = 0;
+
+  // Sizes triangle t's box to its bounds at xs and ys grown by reach / 2 on
+  // every side (so two boxes overlap when the triangles may be within reach).
+  void fitBox(std::size_t t, const std::vector<Vec3>& xs, const std::vector<Vec3>& ys,
+              double reach) {
+    const auto& tri = triangles[t];
+    Vec3 lo = xs[static_cast<std::size_t>(tri[0])], hi = lo;
+    for (int k = 0; k < 3; ++k) {
+      const auto v = static_cast<std::size_t>(tri[static_cast<std::size_t>(k)]);
+      lo = lo.cwiseMin(xs[v]).cwiseMin(ys[v]);
+      hi = hi.cwiseMax(xs[v]).cwiseMax(ys[v]);
+    }
+    boxes[t]->side = (hi - lo) + Vec3::Constant(reach);
+    boxes[t]->computeLocalAABB();
+    objects[t]->setTranslation(0.5 * (lo + hi));
+    objects[t]->computeAABB();
+  }
+};
+
+SelfContactDetector::SelfContactDetector(std::vector<std::array<int, 3>> triangles,
+                                         std::vector<Vec2> pattern, double contactDistance)
+    : impl_(std::make_unique<Impl>()) {
+  if (!(contactDistance > 0.0) || !std::isfinite(contactDistance))
+    throw std::invalid_argument("SelfContactDetector: contact distance must be > 0");
+  for (const auto& t : triangles)
+    for (int v : t)
+      if (v < 0 || static_cast<std::size_t>(v) >= pattern.size())
+        throw std::invalid_argument("SelfContactDetector: triangle index out of range");
+  impl_->triangles = std::move(triangles);
+  impl_->pattern = std::move(pattern);
+  impl_->contactDistance = contactDistance;
+}
+
+SelfContactDetector::~SelfContactDetector() = default;
+SelfContactDetector::SelfContactDetector(SelfContactDetector&&) noexcept = default;
+SelfContactDetector& SelfContactDetector::operator=(SelfContactDetector&&) noexcept = default;
+
+std::size_t SelfContactDetector::broadPhasePairs() const { return impl_->lastPairs; }
+
+std::vector<SelfContactPair> SelfContactDetector::find(const std::vector<Vec3>& xs, double reach,
+                                                       const std::vector<char>* vertexMask) {
+  return find(xs, xs, reach, vertexMask);
+}
+
+std::vector<SelfContactPair> SelfContactDetector::find(const std::vector<Vec3>& xs,
+                                                       const std::vector<Vec3>& ys, double reach,
+                                                       const std::vector<char>* vertexMask) {
+  Impl& m = *impl_;
+  if (!(reach > 0.0) || !std::isfinite(reach))
+    throw std::invalid_argument("SelfContactDetector::find: margin must be > 0");
+  if (xs.size() != m.pattern.size() || ys.size() != m.pattern.size())
+    throw std::invalid_argument("SelfContactDetector::find: positions do not match the sheet");
+  const std::size_t nt = m.triangles.size();
+  // Broad phase: FCL's dynamic AABB tree, built once and refitted per call.
+  if (!m.manager) {
+    m.manager = std::make_unique<fcl::DynamicAABBTreeCollisionManagerd>();
+    std::vector<fcl::CollisionObjectd*> all;
+    for (std::size_t t = 0; t < nt; ++t) {
+      m.boxes.push_back(std::make_shared<fcl::Boxd>(1.0, 1.0, 1.0));
+      m.objects.push_back(std::make_unique<fcl::CollisionObjectd>(m.boxes.back()));
+      m.objects.back()->setUserData(reinterpret_cast<void*>(static_cast<std::intptr_t>(t)));
+      m.fitBox(t, xs, ys, reach);
+      all.push_back(m.objects.back().get());
+    }
+    m.manager->registerObjects(all);
+    m.manager->setup();
+  } else {
+    for (std::size_t t = 0; t < nt; ++t) m.fitBox(t, xs, ys, reach);
+    m.manager->update();
+  }
+  BroadPhaseData data;
+  data.triangles = &m.triangles;
+  m.manager->collide(&data, recordPair);
+  // The tree's traversal order depends on its history: sort for determinism.
+  std::sort(data.pairs.begin(), data.pairs.end());
+  data.pairs.erase(std::unique(data.pairs.begin(), data.pairs.end()), data.pairs.end());
+  m.lastPairs = data.pairs.size();
+
+  // Narrow phase: each vertex of one triangle against the other triangle.
+  const double exclusion = kSelfContactRestExclusion * m.contactDistance;
+  std::vector<SelfContactPair> out;
+  auto test = [&](int vertex, int triangle) {
+    const auto vi = static_cast<std::size_t>(vertex);
+    if (vertexMask != nullptr && (*vertexMask)[vi] == 0) return;
+    const auto& t = m.triangles[static_cast<std::size_t>(triangle)];
+    const Vec3& a = xs[static_cast<std::size_t>(t[0])];
+    const Vec3& b = xs[static_cast<std::size_t>(t[1])];
+    const Vec3& c = xs[static_cast<std::size_t>(t[2])];
+    const std::array<double, 3> w = closestBarycentric(xs[vi], a, b, c);
+    const Vec3 q = w[0] * a + w[1] * b + w[2] * c;
+    const double d = (xs[vi] - q).norm();
+    double moves = (ys[vi] - xs[vi]).norm();
+    double triangleMoves = 0.0;
+    for (int k : t)
+      triangleMoves =
+          std::max(triangleMoves,
+                   (ys[static_cast<std::size_t>(k)] - xs[static_cast<std::size_t>(k)]).norm());
+    moves += triangleMoves;
+    if (!(d < reach + moves)) return;
+    // Material neighbours are one layer, not two.
+    const Vec3 pa = lift(m.pattern[static_cast<std::size_t>(t[0])]);
+    const Vec3 pb = lift(m.pattern[static_cast<std::size_t>(t[1])]);
+    const Vec3 pc = lift(m.pattern[static_cast<std::size_t>(t[2])]);
+    const Vec3 pv = lift(m.pattern[vi]);
+    const std::array<double, 3> pw = closestBarycentric(pv, pa, pb, pc);
+    if ((pv - (pw[0] * pa + pw[1] * pb + pw[2] * pc)).norm() < exclusion) return;
+    SelfContactPair p;
+    p.vertex = vertex;
+    p.triangle = triangle;
+    p.weights = w;
+    p.distance = d;
+    const Vec3 face = (b - a).cross(c - a);
+    const double area2 = face.squaredNorm();
+    if (area2 > 0.0) {
+      // Over the face: the projection's barycentric coordinates are >= 0.
+      const Vec3 r = xs[vi] - a;
+      const Vec3 n = face / std::sqrt(area2);
+      const double wb = (r.cross(c - a)).dot(face) / area2;
+      const double wc = ((b - a).cross(r)).dot(face) / area2;
+      constexpr double kOnEdge = 1e-9;
+      p.face = wb >= -kOnEdge && wc >= -kOnEdge && 1.0 - wb - wc >= -kOnEdge;
+      if (p.face) p.normal = n.dot(r) >= 0.0 ? n : Vec3(-n);
+    }
+    if (!p.face && d > 1e-9 * m.contactDistance) p.normal = (xs[vi] - q) / d;
+    out.push_back(p);
+  };
+  for (const auto& [ta, tb] : data.pairs) {
+    for (int v : m.triangles[static_cast<std::size_t>(ta)]) test(v, tb);
+    for (int v : m.triangles[static_cast<std::size_t>(tb)]) test(v, ta);
+  }
+  std::sort(out.begin(), out.end(), [](const SelfContactPair& l, const SelfContactPair& r) {
+    return l.vertex != r.vertex ? l.vertex < r.vertex : l.triangle < r.triangle;
+  });
+  out.erase(std::unique(out.begin(), out.end(),
+                        [](const SelfContactPair& l, const SelfContactPair& r) {
+                          return l.vertex == r.vertex && l.triangle == r.triangle;
+                        }),
+            out.end());
+  // A vertex over some face keeps its face contacts only.
+  std::vector<SelfContactPair> kept;
+  kept.reserve(out.size());
+  for (std::size_t i = 0; i < out.size();) {
+    std::size_t j = i;
+    bool anyFace = false;
+    for (; j < out.size() && out[j].vertex == out[i].vertex; ++j) anyFace = anyFace || out[j].face;
+    for (std::size_t k = i; k < j; ++k)
+      if (out[k].face || !anyFace) kept.push_back(out[k]);
+    i = j;
+  }
+  return kept;
+}
+
+bool sheetIsFolded(const std::vector<std::array<int, 3>>& triangles, const std::vector<Vec3>& xs,
+                   double maxSpread) {
+  Vec3 mean = Vec3::Zero();
+  std::vector<Vec3> normals;
+  normals.reserve(triangles.size());
+  for (const auto& t : triangles) {
+    const Vec3 n =
+        (xs[static_cast<std::size_t>(t[1])] - xs[static_cast<std::size_t>(t[0])])
+            .cross(xs[static_cast<std::size_t>(t[2])] - xs[static_cast<std::size_t>(t[0])]);
+    mean += n;  // |n| = twice the area: area-weighted
+    const double len = n.norm();
+    if (len > 0.0) normals.push_back(n / len);
+  }
+  const double len = mean.norm();
+  if (!(len > 0.0)) return !normals.empty();
+  mean /= len;
+  const double cosMax = std::cos(maxSpread);
+  return std::any_of(normals.begin(), normals.end(),
+                     [&](const Vec3& n) { return n.dot(mean) < cosMax; });
+}
+
+}  // namespace crumple::sim
