@@ -195,6 +195,21 @@ void HybridSheet::Impl::contactFailsafe(const std::vector<char>& held, std::vect
       if (const auto c = contact.colliders->nearest(x[i], dist); c && c->distance < minGap)
         x[i] += (dist - c->distance) * c->normal;
     }
+    // A ball's centre or a box's corner near the inside of a face: the
+    // face's free vertices move out (the elastic step's face contacts).
+    for (const sim::ColliderProbe& p : contact.colliders->probes()) {
+      for (const auto& t : sp.mesh.triangles) {
+        const Vec3& a = x[static_cast<std::size_t>(t[0])];
+        const Vec3& b = x[static_cast<std::size_t>(t[1])];
+        const Vec3& c = x[static_cast<std::size_t>(t[2])];
+        const Vec3 q = sim::closestPointOnTriangle(p.point, a, b, c);
+        const double d = (q - p.point).norm();
+        if (!(d < p.radius + minGap) || !(d > 0.0)) continue;
+        const Vec3 out = (p.radius + dist - d) * (q - p.point) / d;
+        for (int v : t)
+          if (held[static_cast<std::size_t>(v)] == 0) x[static_cast<std::size_t>(v)] += out;
+      }
+    }
   }
   ms.contacts += msSince(t0);
   t0 = Clock::now();

@@ -56,25 +56,41 @@ LocalHit boxHit(const Vec3& p, const Vec3& h) {
 
 }  // namespace
 
-Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+std::array<double, 3> closestBarycentricOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b,
+                                                   const Vec3& c) {
   const Vec3 ab = b - a, ac = c - a, ap = p - a;
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0.0 && d2 <= 0.0) return a;
+  if (d1 <= 0.0 && d2 <= 0.0) return {1.0, 0.0, 0.0};
   const Vec3 bp = p - b;
   const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0.0 && d4 <= d3) return b;
+  if (d3 >= 0.0 && d4 <= d3) return {0.0, 1.0, 0.0};
   const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return a + (d1 / (d1 - d3)) * ab;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+    const double s = d1 / (d1 - d3);
+    return {1.0 - s, s, 0.0};
+  }
   const Vec3 cp = p - c;
   const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0.0 && d5 <= d6) return c;
+  if (d6 >= 0.0 && d5 <= d6) return {0.0, 0.0, 1.0};
   const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return a + (d2 / (d2 - d6)) * ac;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+    const double s = d2 / (d2 - d6);
+    return {1.0 - s, 0.0, s};
+  }
   const double va = d3 * d6 - d5 * d4;
-  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0)
-    return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
-  const double denom = 1.0 / (va + vb + vc);
-  return a + ab * (vb * denom) + ac * (vc * denom);
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+    const double s = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {0.0, 1.0 - s, s};
+  }
+  const double denom = va + vb + vc;
+  if (!(std::abs(denom) > 0.0)) return {1.0, 0.0, 0.0};  // degenerate triangle
+  const double v = vb / denom, w = vc / denom;
+  return {1.0 - v - w, v, w};
+}
+
+Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const std::array<double, 3> w = closestBarycentricOnTriangle(p, a, b, c);
+  return w[0] * a + w[1] * b + w[2] * c;
 }
 
 struct ColliderSet::Impl {
@@ -227,6 +243,25 @@ std::optional<ColliderContact> ColliderSet::nearest(const Vec3& p, double margin
                            c.pose.rotation * hit->normal};
   }
   return best;
+}
+
+std::vector<ColliderProbe> ColliderSet::probes() const {
+  std::vector<ColliderProbe> out;
+  for (std::size_t i = 0; i < impl_->colliders.size(); ++i) {
+    const auto& c = impl_->colliders[i];
+    const int id = static_cast<int>(i);
+    if (c.shape.kind == ColliderShape::Kind::Sphere) {
+      out.push_back({id, c.pose.position, c.shape.radius});
+    } else if (c.shape.kind == ColliderShape::Kind::Box) {
+      for (int k = 0; k < 8; ++k) {
+        const Vec3& h = c.shape.halfExtents;
+        const Vec3 corner((k & 1) ? h.x() : -h.x(), (k & 2) ? h.y() : -h.y(),
+                          (k & 4) ? h.z() : -h.z());
+        out.push_back({id, toWorld(c.pose, corner), 0.0});
+      }
+    }
+  }
+  return out;
 }
 
 }  // namespace crumple::sim

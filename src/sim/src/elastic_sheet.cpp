@@ -141,6 +141,10 @@ using VecX = Eigen::VectorXd;
 // h = 1/96 s, about 1 % of a sheet's thickness (issue 5).
 constexpr double kContactScale = 1000.0;
 constexpr double kFailsafeSlack = kContactFailsafeSlack;
+// Contacts are looked for within 2 D plus this many times the predicted move
+// of a vertex over the step (plus what gravity adds): other forces (a handle
+// pulling) can make it move farther than predicted.
+constexpr double kReachMoves = 1.5;
 // Below this tangential speed (m/s) friction acts as a stiff spring (static
 // friction, smoothed); above it, as Coulomb's constant force.
 constexpr double kFrictionSpeed = 1e-3;
@@ -255,6 +259,26 @@ struct ElasticSheet::Impl {
     }
   };
   std::vector<ContactPlane> contactPlanes;
+  // A collider probe (a ball's centre, a box's corner) near the inside of a
+  // triangle: the triangle's point w keeps radius + D from it along the
+  // normal frozen at the start of the step (vertex contacts alone let a
+  // ball through a coarse mesh). The penalty acts on the triangle's
+  // vertices through w, in the triangle's own block.
+  struct FaceContact {
+    int triangle;
+    int collider;
+    std::array<double, 3> w;
+    Vec3 probe;  // where the probe ends the step
+    double radius;
+    Vec3 normal;  // unit, from the probe toward the sheet
+    double k;
+    double gap(const std::vector<Vec3>& xs, const std::array<int, 3>& t, double distance) const {
+      Vec3 q = Vec3::Zero();
+      for (std::size_t a = 0; a < 3; ++a) q += w[a] * xs[static_cast<std::size_t>(t[a])];
+      return radius + distance - normal.dot(q - probe);
+    }
+  };
+  std::vector<FaceContact> faceContacts;
   std::vector<SelfContactPair> selfPairs;  // this step's, for the failsafe
   std::vector<ContactSample> lastContacts;
   long contactVertexSteps = 0;  // contacts found, summed over steps (statistics)
@@ -262,6 +286,8 @@ struct ElasticSheet::Impl {
   // The contact planes of a step from x_n (xn) to the predictor xk.
   void findContacts(const std::vector<Vec3>& xn, const std::vector<Vec3>& xk, double h,
                     StepStats& stats);
+  void findFaceContacts(const std::vector<Vec3>& xn, const std::vector<Vec3>& xk, double h,
+                        double fall);
   // Failsafe projection and the step's contact samples.
   struct Pushed {
     std::size_t vertex;
@@ -629,14 +655,17 @@ void ElasticSheet::Impl::findContacts(const std::vector<Vec3>& xn, const std::ve
     return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
   };
   contactPlanes.clear();
+  faceContacts.clear();
   selfPairs.clear();
   const double dist = contact.distance;
+  // The predictor leaves out what gravity adds over the step.
+  const double fall = h * h * params.gravity.norm();
   if (collidersOn()) {
     const auto start = Clock::now();
     const ColliderSet& set = *contact.colliders;
     for (std::size_t i = 0; i < vertexCount; ++i) {
       if (freeIndex[i] < 0) continue;
-      const double reach = 2.0 * dist + (xk[i] - xn[i]).norm();
+      const double reach = 2.0 * dist + kReachMoves * (xk[i] - xn[i]).norm() + fall;
       if (const auto c = set.nearest(xn[i], reach)) {
         const double k = kContactScale * mass[i] / (h * h);
         // The normal force the penalty exerted at x_n, lagged for friction.
@@ -646,6 +675,7 @@ void ElasticSheet::Impl::findContacts(const std::vector<Vec3>& xn, const std::ve
                                  set.friction(c->collider), lambda, k});
       }
     }
+    findFaceContacts(xn, xk, h, fall);
     stats.contactMs += since(start);
   }
   if (contact.self != SelfContactMode::Off) {
@@ -656,7 +686,7 @@ void ElasticSheet::Impl::findContacts(const std::vector<Vec3>& xn, const std::ve
       if (!selfDetector) selfDetector.emplace(triangles, pattern, dist);
       std::vector<char> mask(vertexCount, 0);
       for (std::size_t i = 0; i < vertexCount; ++i) mask[i] = freeIndex[i] >= 0 ? 1 : 0;
-      selfPairs = selfDetector->find(xn, xk, 2.0 * dist, &mask);
+      selfPairs = selfDetector->find(xn, xk, 2.0 * dist + 2.0 * fall, &mask);
       for (const SelfContactPair& p : selfPairs) {
         const auto& t = triangles[static_cast<std::size_t>(p.triangle)];
         Vec3 at = Vec3::Zero(), motion = Vec3::Zero();
@@ -685,7 +715,45 @@ void ElasticSheet::Impl::findContacts(const std::vector<Vec3>& xn, const std::ve
     }
     stats.selfContactMs += since(start);
   }
-  contactVertexSteps += static_cast<long>(contactPlanes.size());
+  contactVertexSteps += static_cast<long>(contactPlanes.size() + faceContacts.size());
+}
+
+void ElasticSheet::Impl::findFaceContacts(const std::vector<Vec3>& xn, const std::vector<Vec3>& xk,
+                                          double h, double fall) {
+  const std::vector<ColliderProbe> probes = contact.colliders->probes();
+  if (probes.empty()) return;
+  const double dist = contact.distance;
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const auto& tri = triangles[t];
+    const auto i0 = static_cast<std::size_t>(tri[0]), i1 = static_cast<std::size_t>(tri[1]),
+               i2 = static_cast<std::size_t>(tri[2]);
+    if (freeIndex[i0] < 0 && freeIndex[i1] < 0 && freeIndex[i2] < 0) continue;
+    const Vec3 lo = xn[i0].cwiseMin(xn[i1]).cwiseMin(xn[i2]);
+    const Vec3 hi = xn[i0].cwiseMax(xn[i1]).cwiseMax(xn[i2]);
+    const double moves =
+        std::max({(xk[i0] - xn[i0]).norm(), (xk[i1] - xn[i1]).norm(), (xk[i2] - xn[i2]).norm()});
+    for (const ColliderProbe& p : probes) {
+      const double reach = p.radius + 2.0 * dist + kReachMoves * moves + fall;
+      if (((p.point - lo).array() < -reach).any() || ((p.point - hi).array() > reach).any())
+        continue;
+      const std::array<double, 3> w = closestBarycentricOnTriangle(p.point, xn[i0], xn[i1], xn[i2]);
+      if (std::max({w[0], w[1], w[2]}) > 1.0 - 1e-9) continue;  // at a vertex: its own contact
+      const Vec3 q = w[0] * xn[i0] + w[1] * xn[i1] + w[2] * xn[i2];
+      const double d = (q - p.point).norm();
+      if (!(d < reach)) continue;
+      Vec3 n = (xn[i1] - xn[i0]).cross(xn[i2] - xn[i0]);
+      if (d > 1e-9 * dist) {
+        n = (q - p.point) / d;
+      } else if (n.norm() > 0.0) {
+        n.normalize();  // the probe is on the face: push the face along its normal
+      } else {
+        continue;
+      }
+      const double m = w[0] * mass[i0] + w[1] * mass[i1] + w[2] * mass[i2];
+      faceContacts.push_back(
+          {static_cast<int>(t), p.collider, w, p.point, p.radius, n, kContactScale * m / (h * h)});
+    }
+  }
 }
 
 // Failsafe: a free vertex the penalty left nearer than (1 - slack) D to a
@@ -726,6 +794,35 @@ void ElasticSheet::Impl::resolveContacts(const std::vector<Vec3>& xn, std::vecto
                            kContactScale * mass[i] / (h * h) * (dist - c->distance)});
         xk[i] += (dist - c->distance) * c->normal;
         pushed.push_back({i, c->normal, surfaceVelocity});
+      }
+    }
+    // Faces a probe came through or too near: the triangle moves out.
+    for (const FaceContact& fc : faceContacts) {
+      const auto& tri = triangles[static_cast<std::size_t>(fc.triangle)];
+      const std::array<Vec3, 3> corner{xk[static_cast<std::size_t>(tri[0])],
+                                       xk[static_cast<std::size_t>(tri[1])],
+                                       xk[static_cast<std::size_t>(tri[2])]};
+      const std::array<double, 3> w =
+          closestBarycentricOnTriangle(fc.probe, corner[0], corner[1], corner[2]);
+      const Vec3 q = w[0] * corner[0] + w[1] * corner[1] + w[2] * corner[2];
+      const double along = fc.normal.dot(q - fc.probe);
+      const double gap = fc.radius + dist - along;
+      if (along < fc.radius + minGap) {
+        const Vec3 surfaceVelocity = set.surfaceDisplacement(fc.collider, fc.probe) / h;
+        std::size_t heaviest = 0;
+        for (std::size_t a = 0; a < 3; ++a) {
+          if (w[a] > w[heaviest]) heaviest = a;
+          const auto v = static_cast<std::size_t>(tri[a]);
+          if (freeIndex[v] < 0) continue;
+          xk[v] += gap * fc.normal;
+          pushed.push_back({v, fc.normal, surfaceVelocity});
+        }
+        samples.push_back({tri[heaviest], fc.collider, 0.0, fc.k * gap});
+      } else if (gap > 0.0) {
+        std::size_t heaviest = 0;
+        for (std::size_t a = 1; a < 3; ++a)
+          if (w[a] > w[heaviest]) heaviest = a;
+        samples.push_back({tri[heaviest], fc.collider, 0.0, fc.k * gap});
       }
     }
     stats.contactMs += since(start);
@@ -884,6 +981,11 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
       if (gap > 0.0) e += 0.5 * cp.k * gap * gap;
       e += frictionTerms(cp, xs[vi], xn[vi], nullptr, nullptr);
     }
+    for (const auto& fc : faceContacts) {
+      const double gap =
+          fc.gap(xs, triangles[static_cast<std::size_t>(fc.triangle)], contact.distance);
+      if (gap > 0.0) e += 0.5 * fc.k * gap * gap;
+    }
     return e;
   };
   static const bool debugNewton = [] {
@@ -925,6 +1027,15 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
       frictionTerms(cp, xk[vi], xn[vi], &g, nullptr);
       gradV.segment<3>(3 * freeIndex[vi]) += g;
     }
+    for (const auto& fc : faceContacts) {
+      const auto& tri = triangles[static_cast<std::size_t>(fc.triangle)];
+      const double gap = fc.gap(xk, tri, contact.distance);
+      if (!(gap > 0.0)) continue;
+      for (std::size_t a = 0; a < 3; ++a) {
+        const int fi = freeIndex[static_cast<std::size_t>(tri[a])];
+        if (fi >= 0) gradV.segment<3>(3 * fi) -= fc.k * gap * fc.w[a] * fc.normal;
+      }
+    }
     grad = gradQ + gradV;
     if (!grad.allFinite()) {
       why = "non-finite forces";
@@ -958,6 +1069,17 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
         const int* off = vertexOffset.data() + 9 * freeIndex[vi];
         for (int col = 0; col < 3; ++col)
           for (int row = col; row < 3; ++row) values[off[col * 3 + row]] += block(row, col);
+      }
+      for (const auto& fc : faceContacts) {
+        const auto& tri = triangles[static_cast<std::size_t>(fc.triangle)];
+        if (!(fc.gap(xk, tri, contact.distance) > 0.0)) continue;
+        Vec9 g;
+        for (int a = 0; a < 3; ++a)
+          g.segment<3>(3 * a) = fc.w[static_cast<std::size_t>(a)] * fc.normal;
+        const Mat9 block = fc.k * g * g.transpose();
+        const int* off = triOffset.data() + 81 * fc.triangle;
+        for (int i = 0; i < 81; ++i)
+          if (off[i] >= 0) values[off[i]] += block.data()[i];
       }
       return Eigen::Map<const VecX>(values, matrix.nonZeros()).allFinite();
     };
@@ -1037,7 +1159,8 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
       double deltaV = 0.0;
       for (std::size_t i = 0; i < triangles.size(); ++i) deltaV += triTrial[i] - triEnergy[i];
       for (std::size_t k = 0; k < hinges.size(); ++k) deltaV += hingeTrial[k] - hingeEnergy[k];
-      if (!contactPlanes.empty()) deltaV += contactEnergy(xTrial) - contactNow;
+      if (!contactPlanes.empty() || !faceContacts.empty())
+        deltaV += contactEnergy(xTrial) - contactNow;
       const double deltaPhi = s * slopeQ + 0.5 * s * s * curvature + deltaV;
       if (std::isfinite(deltaPhi) && deltaPhi <= kArmijo * s * slope) {
         accepted = true;
@@ -1085,7 +1208,8 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
   }
   std::vector<Pushed> pushed;
   lastContacts.clear();
-  if (!contactPlanes.empty() || collidersOn()) resolveContacts(xn, xk, h, stats, pushed);
+  if (!contactPlanes.empty() || !faceContacts.empty() || collidersOn())
+    resolveContacts(xn, xk, h, stats, pushed);
   for (std::size_t i = 0; i < nv; ++i) {
     v[i] = (xk[i] - xn[i]) / h;
     x[i] = xk[i];

@@ -8,43 +8,11 @@
 #include <stdexcept>
 #include <utility>
 
+#include "crumple/sim/colliders.hpp"
+
 namespace crumple::sim {
 
 namespace {
-
-// Barycentric coordinates of the point of triangle (a, b, c) closest to p
-// (Ericson, Real-Time Collision Detection, 5.1.5, with the weights kept).
-std::array<double, 3> closestBarycentric(const Vec3& p, const Vec3& a, const Vec3& b,
-                                         const Vec3& c) {
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0.0 && d2 <= 0.0) return {1.0, 0.0, 0.0};
-  const Vec3 bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0.0 && d4 <= d3) return {0.0, 1.0, 0.0};
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
-    const double s = d1 / (d1 - d3);
-    return {1.0 - s, s, 0.0};
-  }
-  const Vec3 cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0.0 && d5 <= d6) return {0.0, 0.0, 1.0};
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
-    const double s = d2 / (d2 - d6);
-    return {1.0 - s, 0.0, s};
-  }
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
-    const double s = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    return {0.0, 1.0 - s, s};
-  }
-  const double denom = va + vb + vc;
-  if (!(std::abs(denom) > 0.0)) return {1.0, 0.0, 0.0};  // degenerate triangle
-  const double v = vb / denom, w = vc / denom;
-  return {1.0 - v - w, v, w};
-}
 
 Vec3 lift(const Vec2& p) { return {p.x(), p.y(), 0.0}; }
 
@@ -170,7 +138,7 @@ std::vector<SelfContactPair> SelfContactDetector::find(const std::vector<Vec3>& 
     const Vec3& a = xs[static_cast<std::size_t>(t[0])];
     const Vec3& b = xs[static_cast<std::size_t>(t[1])];
     const Vec3& c = xs[static_cast<std::size_t>(t[2])];
-    const std::array<double, 3> w = closestBarycentric(xs[vi], a, b, c);
+    const std::array<double, 3> w = closestBarycentricOnTriangle(xs[vi], a, b, c);
     const Vec3 q = w[0] * a + w[1] * b + w[2] * c;
     const double d = (xs[vi] - q).norm();
     double moves = (ys[vi] - xs[vi]).norm();
@@ -186,7 +154,7 @@ std::vector<SelfContactPair> SelfContactDetector::find(const std::vector<Vec3>& 
     const Vec3 pb = lift(m.pattern[static_cast<std::size_t>(t[1])]);
     const Vec3 pc = lift(m.pattern[static_cast<std::size_t>(t[2])]);
     const Vec3 pv = lift(m.pattern[vi]);
-    const std::array<double, 3> pw = closestBarycentric(pv, pa, pb, pc);
+    const std::array<double, 3> pw = closestBarycentricOnTriangle(pv, pa, pb, pc);
     if ((pv - (pw[0] * pa + pw[1] * pb + pw[2] * pc)).norm() < exclusion) return;
     SelfContactPair p;
     p.vertex = vertex;

@@ -38,6 +38,17 @@ struct ColliderContact {
   Vec3 normal = Vec3::UnitY();  // unit, out of the collider (world)
 };
 
+// A point of a collider that can poke into the sheet between its vertices
+// (vertex contacts alone let a ball pass through a coarse mesh): the centre
+// of a sphere with its radius, the corners of a box with radius 0. Planes
+// cannot (a plane meets a triangle first at a vertex); mesh colliders have
+// none yet (their vertices against the sheet's faces are not tested).
+struct ColliderProbe {
+  int collider = -1;
+  Vec3 point = Vec3::Zero();  // world, at the collider's current pose
+  double radius = 0.0;
+};
+
 class ColliderSet {
  public:
   ColliderSet();
@@ -66,6 +77,8 @@ class ColliderSet {
   // lowest signed distance (the deepest penetration); nullopt when there is
   // none. Ties go to the lowest collider index (deterministic).
   std::optional<ColliderContact> nearest(const Vec3& p, double margin) const;
+  // Every collider's probes at its current pose, in collider order.
+  std::vector<ColliderProbe> probes() const;
 
  private:
   struct Impl;
@@ -73,7 +86,9 @@ class ColliderSet {
 };
 
 // Closest point of triangle (a, b, c) to p (Ericson, Real-Time Collision
-// Detection, 5.1.5).
+// Detection, 5.1.5), and its barycentric coordinates.
 Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+std::array<double, 3> closestBarycentricOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b,
+                                                   const Vec3& c);
 
 }  // namespace crumple::sim

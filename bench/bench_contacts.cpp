@@ -1,0 +1,130 @@
+// What contacts cost (issue 5: "contact cost per frame for each sample and
+// its share of the step"):
+//
+//   bench_contacts [SAMPLE ...] [--runs 3] [--json FILE]
+//
+// Simulates each sample (default: slide-on-table, press-on-sphere,
+// fold-over) `runs`
+// times on one thread, without rendering, and prints the medians of the
+// simulation step per frame, the collider and the self-contact work per
+// frame (detection, penalties' setup, failsafe; the Newton iterations the
+// penalties add are the elastic solve's), their share of the step, and the
+// contact-depth check the pipeline runs at every frame.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "crumple/core/parallel.hpp"
+#include "crumple/io/scene.hpp"
+#include "crumple/pipeline/shot.hpp"
+
+namespace {
+
+using namespace crumple;
+namespace fs = std::filesystem;
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+struct Row {
+  std::string sample;
+  int frames = 0;
+  double stepMs = 0.0, colliderMs = 0.0, selfMs = 0.0, share = 0.0, checkMs = 0.0, depth = 0.0;
+  long selfSubsteps = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int runs = 3;
+  std::string jsonPath;
+  std::vector<std::string> samples;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--runs" && i + 1 < argc) {
+      runs = std::max(1, std::atoi(argv[++i]));
+    } else if (a == "--json" && i + 1 < argc) {
+      jsonPath = argv[++i];
+    } else if (a == "--help" || a == "-h") {
+      std::printf("usage: bench_contacts [SAMPLE ...] [--runs 3] [--json FILE]\n");
+      return 0;
+    } else {
+      samples.push_back(a);
+    }
+  }
+  if (samples.empty()) samples = {"slide-on-table", "press-on-sphere", "fold-over"};
+  setThreadCount(1);
+  const fs::path scratch = fs::temp_directory_path() / "crumple-bench-contacts";
+  std::vector<Row> rows;
+  for (const std::string& name : samples) {
+    const io::SceneSpec scene =
+        io::loadScene(io::resolveScenePath(std::string(CRUMPLE_SOURCE_DIR) + "/samples/" + name));
+    std::vector<double> step, collider, self, share, check;
+    Row row;
+    row.sample = name;
+    for (int r = 0; r < runs; ++r) {
+      pipeline::ShotOptions options;
+      options.outDir = (scratch / name).string();
+      options.render = false;
+      options.log = std::fopen("/dev/null", "w");
+      options.interactive = 0;
+      const pipeline::ShotReport report = pipeline::runShot(scene, options);
+      std::fclose(options.log);
+      const double frames = std::max(1, report.framesSimulated - 1);
+      double stepTotal = 0.0;
+      for (const char* s : {"elastic", "geometric", "cones", "rebuild", "isometry", "contacts"})
+        if (const auto it = report.stages.find(s); it != report.stages.end())
+          stepTotal += it->second.totalMs;
+      step.push_back(stepTotal / frames);
+      collider.push_back(report.contactMs / frames);
+      self.push_back(report.selfContactMs / frames);
+      share.push_back(report.contactShareOfStep());
+      const auto c = report.stages.find("contact check");
+      check.push_back(c != report.stages.end() ? c->second.msPerFrame() : 0.0);
+      row.frames = report.framesSimulated;
+      row.depth = report.maxContactDepth;
+      row.selfSubsteps = report.selfContactSteps;
+    }
+    row.stepMs = median(step);
+    row.colliderMs = median(collider);
+    row.selfMs = median(self);
+    row.share = median(share);
+    row.checkMs = median(check);
+    rows.push_back(row);
+    std::printf(
+        "%-16s %3d frames  step %8.2f ms/frame  colliders %6.2f  self-contact %6.2f ms/frame "
+        "(%ld substeps)  share %5.1f %%  depth check %5.2f ms/frame  deepest %.3f thickness\n",
+        row.sample.c_str(), row.frames, row.stepMs, row.colliderMs, row.selfMs, row.selfSubsteps,
+        100.0 * row.share, row.checkMs, row.depth);
+    std::fflush(stdout);
+  }
+  std::error_code ignored;
+  fs::remove_all(scratch, ignored);
+  if (!jsonPath.empty()) {
+    std::FILE* f = std::fopen(jsonPath.c_str(), "w");
+    if (f == nullptr) {
+      std::fprintf(stderr, "bench_contacts: cannot write %s\n", jsonPath.c_str());
+      return 1;
+    }
+    std::fprintf(f, "{\"runs\": %d, \"samples\": [", runs);
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const Row& r = rows[i];
+      std::fprintf(f,
+                   "%s{\"sample\": \"%s\", \"frames\": %d, \"step_ms_per_frame\": %.6g, "
+                   "\"collider_ms_per_frame\": %.6g, \"self_contact_ms_per_frame\": %.6g, "
+                   "\"share_of_step\": %.6g, \"depth_check_ms_per_frame\": %.6g, "
+                   "\"max_depth_thicknesses\": %.6g}",
+                   i ? ", " : "", r.sample.c_str(), r.frames, r.stepMs, r.colliderMs, r.selfMs,
+                   r.share, r.checkMs, r.depth);
+    }
+    std::fprintf(f, "]}\n");
+    std::fclose(f);
+  }
+  return 0;
+}
