@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "byte_encoder.hpp"
 #include "crumple/core/crc32.hpp"
 #include "crumple/core/error.hpp"
 
@@ -21,8 +22,9 @@ static_assert(std::numeric_limits<double>::is_iec559 && sizeof(double) == 8,
               "doubles are stored as IEEE-754 binary64");
 static_assert(sizeof(int) == 4, "ints are stored as 32-bit two's complement");
 
-using Bytes = std::vector<std::uint8_t>;
-using Tag = std::array<char, 4>;
+using detail::Bytes;
+using detail::Encoder;
+using detail::Tag;
 
 constexpr std::array<std::uint8_t, 8> kFileMagic{'P', 'C', 'A', 'C', 'H', 'E', 0x00, 0x01};
 constexpr std::array<std::uint8_t, 8> kEndMagic{'P', 'C', 'A', 'C', 'H', 'E', 'N', 'D'};
@@ -58,41 +60,6 @@ std::string tagText(const Tag& tag) {
   }
   return s;
 }
-
-// ---------------------------------------------------------------------------
-// Little-endian encoding, byte by byte: independent of the host's byte order.
-
-class Encoder {
- public:
-  explicit Encoder(Bytes& out) : out_(out) {}
-
-  void u8(std::uint8_t v) { out_.push_back(v); }
-  void u32(std::uint32_t v) { put(v, 4); }
-  void u64(std::uint64_t v) { put(v, 8); }
-  void i32(int v) { u32(static_cast<std::uint32_t>(v)); }
-  void f64(double v) { u64(std::bit_cast<std::uint64_t>(v)); }
-  void raw(const void* data, std::size_t n) {
-    const auto* b = static_cast<const std::uint8_t*>(data);
-    out_.insert(out_.end(), b, b + n);
-  }
-  void tag(const Tag& t) { raw(t.data(), t.size()); }
-  void count(std::size_t n, const char* what) {
-    if (n > std::numeric_limits<std::uint32_t>::max())
-      throw std::length_error(std::string("pcache: too many ") + what + " (" + std::to_string(n) +
-                              ") for a 32-bit count");
-    u32(static_cast<std::uint32_t>(n));
-  }
-  void str(const std::string& s, const char* what) {
-    count(s.size(), what);
-    raw(s.data(), s.size());
-  }
-
- private:
-  void put(std::uint64_t v, int bytes) {
-    for (int k = 0; k < bytes; ++k) out_.push_back(static_cast<std::uint8_t>(v >> (8 * k)));
-  }
-  Bytes& out_;
-};
 
 // Malformed payload bytes. Callers turn it into InputError (header) or
 // CorruptDataError (frames) with the file and frame named.

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "byte_encoder.hpp"
 #include "crumple/core/error.hpp"
 
 namespace crumple::cache {
@@ -21,38 +22,13 @@ static_assert(std::numeric_limits<double>::is_iec559 && sizeof(double) == 8,
               "doubles are stored as IEEE-754 binary64");
 static_assert(sizeof(int) == 4, "ints are stored as 32-bit two's complement");
 
-using Bytes = std::vector<std::uint8_t>;
+using detail::Bytes;
+using detail::Encoder;
 
 // Smallest encoded record: a collider with two empty strings (2 u32 + f64),
 // a contact (2 i32 + 2 f32).
 constexpr std::size_t kMinColliderBytes = 4 + 4 + 8;
 constexpr std::size_t kContactBytes = 4 + 4 + 4 + 4;
-
-// Little-endian, byte by byte (independent of the host's byte order), with
-// the same `str` encoding as the HEAD chunk: u32 byte count, then the bytes.
-class Writer {
- public:
-  void u32(std::uint32_t v) { put(v, 4); }
-  void i32(int v) { u32(static_cast<std::uint32_t>(v)); }
-  void f32(float v) { u32(std::bit_cast<std::uint32_t>(v)); }
-  void f64(double v) { put(std::bit_cast<std::uint64_t>(v), 8); }
-  void count(std::size_t n, const char* what) {
-    if (n > std::numeric_limits<std::uint32_t>::max())
-      throw std::length_error(std::string("pcache: too many ") + what + " (" + std::to_string(n) +
-                              ") for a 32-bit count");
-    u32(static_cast<std::uint32_t>(n));
-  }
-  void str(const std::string& s, const char* what) {
-    count(s.size(), what);
-    bytes.insert(bytes.end(), s.begin(), s.end());
-  }
-  Bytes bytes;
-
- private:
-  void put(std::uint64_t v, int n) {
-    for (int k = 0; k < n; ++k) bytes.push_back(static_cast<std::uint8_t>(v >> (8 * k)));
-  }
-};
 
 // Reads a block; errors name the block, the record being read (at()) and
 // the field. Messages are built only on failure.
@@ -155,7 +131,8 @@ std::string frictionProblem(double friction) {
 }  // namespace
 
 ExtensionBlock encodeColliders(const std::vector<ColliderInfo>& colliders) {
-  Writer w;
+  Bytes bytes;
+  Encoder w(bytes);
   w.count(colliders.size(), "colliders");
   for (std::size_t i = 0; i < colliders.size(); ++i) {
     const auto& c = colliders[i];
@@ -166,11 +143,12 @@ ExtensionBlock encodeColliders(const std::vector<ColliderInfo>& colliders) {
     w.str(c.material, "bytes in a collider material");
     w.f64(c.friction);
   }
-  return {kCollidersTag, std::move(w.bytes)};
+  return {kCollidersTag, std::move(bytes)};
 }
 
 ExtensionBlock encodeContacts(const std::vector<ContactRecord>& contacts) {
-  Writer w;
+  Bytes bytes;
+  Encoder w(bytes);
   w.count(contacts.size(), "contacts");
   for (std::size_t i = 0; i < contacts.size(); ++i) {
     const auto& c = contacts[i];
@@ -181,7 +159,7 @@ ExtensionBlock encodeContacts(const std::vector<ContactRecord>& contacts) {
     w.f32(c.slideSpeed);
     w.f32(c.normalForce);
   }
-  return {kContactsTag, std::move(w.bytes)};
+  return {kContactsTag, std::move(bytes)};
 }
 
 std::optional<std::vector<ColliderInfo>> decodeColliders(

@@ -251,22 +251,7 @@ void HybridSheet::Impl::carryContacts(const std::vector<sim::ContactSample>& sam
     carried.vertex = static_cast<int>(best);
     contacts.push_back(carried);
   }
-  std::sort(contacts.begin(), contacts.end(),
-            [](const sim::ContactSample& l, const sim::ContactSample& r) {
-              return l.vertex != r.vertex ? l.vertex < r.vertex : l.collider < r.collider;
-            });
-  // Two samples carried onto one vertex: forces summed, the fastest slide.
-  std::vector<sim::ContactSample> merged;
-  for (const sim::ContactSample& s : contacts) {
-    if (!merged.empty() && merged.back().vertex == s.vertex &&
-        merged.back().collider == s.collider) {
-      merged.back().normalForce += s.normalForce;
-      merged.back().slideSpeed = std::max(merged.back().slideSpeed, s.slideSpeed);
-    } else {
-      merged.push_back(s);
-    }
-  }
-  contacts = std::move(merged);
+  sim::mergeContactSamples(contacts);  // two samples may land on one vertex
 }
 
 HybridSheet::HybridSheet(GeometricMesh sg, const sim::Material& material,

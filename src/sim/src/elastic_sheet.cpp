@@ -862,19 +862,8 @@ void ElasticSheet::Impl::resolveContacts(const std::vector<Vec3>& xn, std::vecto
     }
     stats.selfContactMs += since(start);
   }
-  // One sample per (vertex, collider): forces summed, the fastest slide.
-  std::sort(samples.begin(), samples.end(), [](const ContactSample& l, const ContactSample& r) {
-    return l.vertex != r.vertex ? l.vertex < r.vertex : l.collider < r.collider;
-  });
-  for (const ContactSample& sample : samples) {
-    if (!lastContacts.empty() && lastContacts.back().vertex == sample.vertex &&
-        lastContacts.back().collider == sample.collider) {
-      lastContacts.back().normalForce += sample.normalForce;
-      lastContacts.back().slideSpeed = std::max(lastContacts.back().slideSpeed, sample.slideSpeed);
-    } else {
-      lastContacts.push_back(sample);
-    }
-  }
+  mergeContactSamples(samples);
+  lastContacts = std::move(samples);
 }
 
 bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, StepStats& stats,
@@ -1291,6 +1280,24 @@ StepStats ElasticSheet::advance(double t, double dt, const PinFunction& pins) {
     throw NumericalError("elastic", os.str());
   }
   return stats;
+}
+
+void mergeContactSamples(std::vector<ContactSample>& samples) {
+  std::sort(samples.begin(), samples.end(), [](const ContactSample& l, const ContactSample& r) {
+    return l.vertex != r.vertex ? l.vertex < r.vertex : l.collider < r.collider;
+  });
+  std::vector<ContactSample> merged;
+  merged.reserve(samples.size());
+  for (const ContactSample& s : samples) {
+    if (!merged.empty() && merged.back().vertex == s.vertex &&
+        merged.back().collider == s.collider) {
+      merged.back().normalForce += s.normalForce;
+      merged.back().slideSpeed = std::max(merged.back().slideSpeed, s.slideSpeed);
+    } else {
+      merged.push_back(s);
+    }
+  }
+  samples = std::move(merged);
 }
 
 void ElasticSheet::setContacts(ContactOptions options) {

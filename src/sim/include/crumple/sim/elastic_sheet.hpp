@@ -92,6 +92,10 @@ struct ContactSample {
   double normalForce = 0.0;  // N, the contact's penalty force
 };
 
+// Sorts contact samples by (vertex, collider) and merges the samples of one
+// pair: forces summed, the fastest slide.
+void mergeContactSamples(std::vector<ContactSample>& samples);
+
 class ElasticSheet {
  public:
   // Rest state = the mesh's pattern; initial state = its positions, zero velocity.
