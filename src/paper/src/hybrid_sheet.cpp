@@ -17,7 +17,6 @@
 #include "crumple/paper/cone_fit.hpp"
 #include "crumple/paper/damage.hpp"
 #include "crumple/sim/colliders.hpp"
-#include "crumple/sim/self_contact.hpp"
 #include "region_tools.hpp"
 #include "step_trace.hpp"
 
@@ -153,8 +152,6 @@ struct HybridSheet::Impl {
                      int singularBudget, std::uint64_t& draw, HybridStepStats& stats,
                      const char*& stage);
 
-  // Contact failsafe after the isometry (issue 5), on S_P's free vertices.
-  void contactFailsafe(const std::vector<char>& pinned, std::vector<Vec3>& x, HybridStageTimes& ms);
   // The elastic step's contacts, carried to the current S_P by pattern.
   void carryContacts(const std::vector<sim::ContactSample>& samples,
                      const std::vector<Vec2>& patternBefore);
@@ -183,52 +180,6 @@ struct HybridSheet::Impl {
     }
   }
 };
-
-void HybridSheet::Impl::contactFailsafe(const std::vector<char>& held, std::vector<Vec3>& x,
-                                        HybridStageTimes& ms) {
-  auto t0 = Clock::now();
-  const double dist = contact.distance;
-  const double minGap = (1.0 - sim::kContactFailsafeSlack) * dist;
-  if (contact.colliders != nullptr && contact.colliders->size() > 0) {
-    for (std::size_t i = 0; i < x.size(); ++i) {
-      if (held[i] != 0) continue;
-      if (const auto c = contact.colliders->nearest(x[i], dist); c && c->distance < minGap)
-        x[i] += (dist - c->distance) * c->normal;
-    }
-    // A ball's centre or a box's corner near the inside of a face: the
-    // face's free vertices move out (the elastic step's face contacts).
-    for (const sim::ColliderProbe& p : contact.colliders->probes()) {
-      for (const auto& t : sp.mesh.triangles) {
-        const Vec3& a = x[static_cast<std::size_t>(t[0])];
-        const Vec3& b = x[static_cast<std::size_t>(t[1])];
-        const Vec3& c = x[static_cast<std::size_t>(t[2])];
-        const Vec3 q = sim::closestPointOnTriangle(p.point, a, b, c);
-        const double d = (q - p.point).norm();
-        if (!(d < p.radius + minGap) || !(d > 0.0)) continue;
-        const Vec3 out = (p.radius + dist - d) * (q - p.point) / d;
-        for (int v : t)
-          if (held[static_cast<std::size_t>(v)] == 0) x[static_cast<std::size_t>(v)] += out;
-      }
-    }
-  }
-  ms.contacts += msSince(t0);
-  t0 = Clock::now();
-  if (contact.self == sim::SelfContactMode::On ||
-      (contact.self == sim::SelfContactMode::Auto &&
-       sim::sheetIsFolded(sp.mesh.triangles, x, contact.foldSpread))) {
-    std::vector<char> free(x.size(), 0);
-    for (std::size_t i = 0; i < x.size(); ++i) free[i] = held[i] == 0 ? 1 : 0;
-    sim::SelfContactDetector detector(sp.mesh.triangles, sp.mesh.pattern, dist);
-    for (const sim::SelfContactPair& p : detector.find(x, dist, &free)) {
-      if (!(p.distance < minGap)) continue;
-      const auto& t = sp.mesh.triangles[static_cast<std::size_t>(p.triangle)];
-      Vec3 q = Vec3::Zero();
-      for (std::size_t k = 0; k < 3; ++k) q += p.weights[k] * x[static_cast<std::size_t>(t[k])];
-      x[static_cast<std::size_t>(p.vertex)] = q + dist * p.normal;
-    }
-  }
-  ms.selfContacts += msSince(t0);
-}
 
 void HybridSheet::Impl::carryContacts(const std::vector<sim::ContactSample>& samples,
                                       const std::vector<Vec2>& patternBefore) {
@@ -498,7 +449,8 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
     for (const sim::Pin& p : pinned)
       if (static_cast<std::size_t>(p.vertex) < held.size())
         held[static_cast<std::size_t>(p.vertex)] = 1;
-    m.contactFailsafe(held, positions, stats.ms);
+    sim::projectOutOfContacts(m.contact, m.sp.mesh.triangles, m.sp.mesh.pattern, held, positions,
+                              &stats.ms.contacts, &stats.ms.selfContacts);
     const auto carryStart = Clock::now();
     m.carryContacts(elasticContacts, elasticPattern);
     stats.ms.contacts += msSince(carryStart);

@@ -5,6 +5,7 @@
 // gravity, Rayleigh damping, backward Euler solved by Newton iterations with a
 // line search, sparse Cholesky solves through CHOLMOD (symbolic analysis kept
 // while the topology is unchanged), handle vertices as hard constraints.
+#include <array>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -91,6 +92,20 @@ struct ContactSample {
   double slideSpeed = 0.0;   // m/s, tangential, relative to the touched surface
   double normalForce = 0.0;  // N, the contact's penalty force
 };
+
+// The contact failsafe on its own, for a caller that moves vertices after
+// the elastic step (the crumpling model's isometry projection): free
+// vertices (held[v] == 0) nearer than (1 - kContactFailsafeSlack) distance
+// to a collider move out to the distance along its normal; faces a
+// collider probe came that near move out with their free vertices; and,
+// when self-contact runs for this sheet (On, or Auto and folded), vertices
+// that near to another layer move out along the pair's normal. Adds the
+// wall time of the collider and the self-contact parts (ms) when given.
+void projectOutOfContacts(const ContactOptions& options,
+                          const std::vector<std::array<int, 3>>& triangles,
+                          const std::vector<Vec2>& pattern, const std::vector<char>& held,
+                          std::vector<Vec3>& x, double* collidersMs = nullptr,
+                          double* selfMs = nullptr);
 
 // Sorts contact samples by (vertex, collider) and merges the samples of one
 // pair: forces summed, the fastest slide.
