@@ -600,7 +600,7 @@ std::string summaryText(const ShotReport& r) {
                 r.framesSimulated, r.vertices, r.triangles, r.framesRendered);
   out += line;
   for (const auto& [name, cost] : r.stages) {
-    std::snprintf(line, sizeof line, "  %-8s %9.2f ms/frame over %ld frames\n", name.c_str(),
+    std::snprintf(line, sizeof line, "  %-13s %9.2f ms/frame over %ld frames\n", name.c_str(),
                   cost.msPerFrame(), cost.frames);
     out += line;
   }
