@@ -1,0 +1,182 @@
+// The tearing primitives (issue 6, thesis 3.2.2 and 3.3): the fibers'
+// texture, the Griffith criterion and the tip's propagation, the clustering
+// of the tip's forces into two pulls, and the detail path.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+#include <numbers>
+
+#include "crumple/tear/detail_path.hpp"
+#include "crumple/tear/fiber_texture.hpp"
+#include "crumple/tear/griffith.hpp"
+
+namespace crumple::tear {
+namespace {
+
+// Mean absolute difference between neighbouring texels along u and along v.
+std::array<double, 2> roughness(const FiberTexture& t) {
+  double du = 0.0, dv = 0.0;
+  long n = 0;
+  for (int j = 0; j + 1 < t.height(); ++j)
+    for (int i = 0; i + 1 < t.width(); ++i, ++n) {
+      du += std::abs(t.texel(i + 1, j) - t.texel(i, j));
+      dv += std::abs(t.texel(i, j + 1) - t.texel(i, j));
+    }
+  return {du / static_cast<double>(n), dv / static_cast<double>(n)};
+}
+
+TEST(FiberTexture, SpansZeroToOneAndIsAPureFunctionOfTheSeed) {
+  const FiberTexture a(Vec2::Zero(), Vec2(0.05, 0.03), FiberTextureParams{});
+  EXPECT_EQ(a.width(), 200);
+  EXPECT_EQ(a.height(), 120);
+  double lo = 1.0, hi = 0.0;
+  for (int j = 0; j < a.height(); ++j)
+    for (int i = 0; i < a.width(); ++i) {
+      lo = std::min(lo, a.texel(i, j));
+      hi = std::max(hi, a.texel(i, j));
+    }
+  EXPECT_EQ(lo, 0.0);
+  EXPECT_EQ(hi, 1.0);
+  const FiberTexture same(Vec2::Zero(), Vec2(0.05, 0.03), FiberTextureParams{});
+  FiberTextureParams other;
+  other.seed = 2;
+  const FiberTexture different(Vec2::Zero(), Vec2(0.05, 0.03), other);
+  int equal = 0, changed = 0;
+  for (int j = 0; j < a.height(); ++j)
+    for (int i = 0; i < a.width(); ++i) {
+      equal += a.texel(i, j) == same.texel(i, j) ? 1 : 0;
+      changed += std::abs(a.texel(i, j) - different.texel(i, j)) > 1e-3 ? 1 : 0;
+    }
+  EXPECT_EQ(equal, a.width() * a.height());
+  EXPECT_GT(changed, a.width() * a.height() / 2);
+  // Bilinear sampling meets the texels at their centres.
+  EXPECT_DOUBLE_EQ(a.sample(a.centre(17, 33)), a.texel(17, 33));
+}
+
+TEST(FiberTexture, AnisotropicFibersAreLongerAlongTheirDirection) {
+  const auto iso = roughness(FiberTexture(Vec2::Zero(), Vec2(0.04, 0.04), FiberTextureParams{}));
+  FiberTextureParams p;
+  p.anisotropy = 4.0;
+  p.fiberDirection = Vec2::UnitX();
+  const auto aniso = roughness(FiberTexture(Vec2::Zero(), Vec2(0.04, 0.04), p));
+  std::cout << "[ measure ] texel-to-texel change along / across: isotropic " << iso[0] / iso[1]
+            << ", anisotropy 4 " << aniso[0] / aniso[1] << "\n";
+  EXPECT_NEAR(iso[0] / iso[1], 1.0, 0.2);
+  EXPECT_LT(aniso[0] / aniso[1], 0.5) << "smoother along the fibers";
+}
+
+TEST(FiberTexture, RejectsBadParameters) {
+  FiberTextureParams p;
+  p.texelSize = 0.0;
+  EXPECT_THROW(FiberTexture(Vec2::Zero(), Vec2(0.01, 0.01), p), std::invalid_argument);
+  p = {};
+  p.anisotropy = 0.5;
+  EXPECT_THROW(FiberTexture(Vec2::Zero(), Vec2(0.01, 0.01), p), std::invalid_argument);
+  p = {};
+  p.texelSize = 1e-7;
+  EXPECT_THROW(FiberTexture(Vec2::Zero(), Vec2(1.0, 1.0), p), std::invalid_argument)
+      << "10^14 texels";
+  EXPECT_THROW(FiberTexture(Vec2::Zero(), Vec2(0.0, 0.01), FiberTextureParams{}),
+               std::invalid_argument);
+}
+
+TEST(Griffith, FractureEnergyIsResistanceTimesFibersTimesDamage) {
+  EXPECT_DOUBLE_EQ(fractureEnergy(0.005, 0.6, 1.0), 0.003);
+  EXPECT_DOUBLE_EQ(fractureEnergy(0.005, 0.6, 0.5), 0.0015) << "a tip is weaker";
+  EXPECT_THROW(fractureEnergy(0.005, 1.5, 1.0), std::invalid_argument);
+  EXPECT_THROW(fractureEnergy(-1.0, 0.5, 1.0), std::invalid_argument);
+}
+
+TEST(Griffith, TwoPullsOpenTheTearAlongTheirBisectorAwayFromThem) {
+  // The tip at the origin, pulled toward A = (-1, -1) and B = (1, -1).
+  const Propagation p = propagation(Vec2(-1, -1).normalized(), Vec2(1, -1).normalized());
+  EXPECT_NEAR(p.angle, 0.5 * std::numbers::pi, 1e-12);
+  EXPECT_NEAR(p.energyRelease, 2.0 * std::cos(0.25 * std::numbers::pi), 1e-12);
+  EXPECT_TRUE(p.direction.isApprox(Vec2(0, 1), 1e-12)) << "away from the pulling points";
+  // Parallel pulls (flaps pulled back together) release the most: |L| + |R|.
+  EXPECT_NEAR(propagation(Vec2(0, -2), Vec2(0, -1)).energyRelease, 3.0, 1e-12);
+  // Straight apart: the sheet is stretched across the tear, nothing released.
+  EXPECT_NEAR(propagation(Vec2(-1, 0), Vec2(1, 0)).energyRelease, 0.0, 1e-12);
+  // The Griffith criterion: the tip moves by V E_r only when E_r >= E_f.
+  const Vec2 tip(0.3, 0.2);
+  EXPECT_EQ(advanceTip(tip, p, p.energyRelease + 1e-9, 0.01), tip);
+  EXPECT_TRUE(advanceTip(tip, p, p.energyRelease, 0.01)
+                  .isApprox(tip + 0.01 * p.energyRelease * Vec2(0, 1), 1e-15));
+}
+
+TEST(Griffith, ATearPulledFromTwoFixedPointsFollowsAHyperbola) {
+  // Roman 2013 (thesis 3.3.1, Fig. 3.13): with the pulls toward two points
+  // A and B fixed in the pattern, the tip moves along the bisector of AS and
+  // BS, so |SA| - |SB| stays constant: a hyperbola with foci A and B.
+  const Vec2 a(-0.05, -0.04), b(0.06, -0.03);
+  Vec2 s(0.01, 0.0);
+  const double invariant = (s - a).norm() - (s - b).norm();
+  double travelled = 0.0, worst = 0.0;
+  for (int step = 0; step < 200; ++step) {
+    const Propagation p = propagation((a - s).normalized(), (b - s).normalized());
+    const Vec2 next = advanceTip(s, p, 0.0, 2.5e-4 / p.energyRelease);  // 0.25 mm steps
+    travelled += (next - s).norm();
+    s = next;
+    worst = std::max(worst, std::abs((s - a).norm() - (s - b).norm() - invariant));
+  }
+  std::cout << "[ measure ] after " << travelled << " m of tear, |SA| - |SB| drifted by " << worst
+            << " m\n";
+  EXPECT_NEAR(travelled, 0.05, 1e-9);
+  EXPECT_LT(worst, 1e-3 * travelled) << "first-order steps stay on the hyperbola";
+  EXPECT_GT(s.y(), 0.04) << "it ran away from the pulling points";
+}
+
+TEST(Griffith, ForcesAtATipSplitIntoTheirTwoPulls) {
+  // Three forces toward the upper left and two toward the upper right, in
+  // the XY plane; the first guess of the tear direction is off by 40 deg.
+  const std::vector<Vec3> forces{Vec3(-1.0, 0.9, 0), Vec3(-1.2, 1.1, 0), Vec3(-0.8, 1.0, 0),
+                                 Vec3(1.0, 1.2, 0), Vec3(0.9, 0.8, 0)};
+  const double guess = 40.0 * std::numbers::pi / 180.0;
+  const ForceClusters c =
+      clusterTipForces(forces, Vec3::UnitZ(), Vec3(std::sin(guess), -std::cos(guess), 0));
+  EXPECT_TRUE(c.converged);
+  EXPECT_LE(c.iterations, 10);
+  const Vec3 upperLeft = forces[0] + forces[1] + forces[2], upperRight = forces[3] + forces[4];
+  const bool asIs = c.left.isApprox(upperLeft, 1e-12) && c.right.isApprox(upperRight, 1e-12);
+  const bool swapped = c.left.isApprox(upperRight, 1e-12) && c.right.isApprox(upperLeft, 1e-12);
+  EXPECT_TRUE(asIs || swapped) << c.left.transpose() << " | " << c.right.transpose();
+}
+
+TEST(DetailPath, RunsFromTipToTipRougherThanTheStraightSegment) {
+  // At the default resolution (0.25 mm texels, 2 mm features, p = 0.5): the
+  // acceptance of issue 6 asks for at least 1.15 times the straight length
+  // between tips. 2 cm segments in 8 directions, fiber seeds 1-4.
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    FiberTextureParams fp;
+    fp.seed = seed;
+    const FiberTexture fibers(Vec2::Zero(), Vec2(0.06, 0.06), fp);
+    double ratio = 0.0;
+    for (int k = 0; k < 8; ++k) {
+      const double angle = k * std::numbers::pi / 8.0;
+      const Vec2 from = Vec2(0.03, 0.03) - 0.01 * Vec2(std::cos(angle), std::sin(angle));
+      const Vec2 to = Vec2(0.03, 0.03) + 0.01 * Vec2(std::cos(angle), std::sin(angle));
+      const auto path = detailPath(fibers, from, to, DetailPathParams{});
+      ASSERT_GE(path.size(), 2u);
+      EXPECT_EQ(path.front(), from);
+      EXPECT_EQ(path.back(), to);
+      // Every step forward, within pi/2 of the direction to the end.
+      for (std::size_t i = 1; i + 1 < path.size(); ++i)
+        EXPECT_GT((path[i] - path[i - 1]).dot(to - path[i - 1]), -1e-12) << "segment " << k;
+      EXPECT_EQ(path, detailPath(fibers, from, to, DetailPathParams{})) << "deterministic";
+      ratio += pathLength(path) / (to - from).norm() / 8.0;
+    }
+    std::cout << "[ measure ] seed " << seed
+              << ": detail path / straight segment, mean over 8 directions " << ratio << "\n";
+    EXPECT_GE(ratio, 1.15) << "seed " << seed;
+  }
+  const FiberTexture fibers(Vec2::Zero(), Vec2(0.06, 0.06), FiberTextureParams{});
+  // All stress and no fibers: the walk hugs the segment.
+  DetailPathParams straight;
+  straight.blend = 1.0;
+  const auto path = detailPath(fibers, Vec2(0.02, 0.03), Vec2(0.04, 0.03), straight);
+  EXPECT_NEAR(pathLength(path), 0.02, 0.5e-3) << "two texels";
+}
+
+}  // namespace
+}  // namespace crumple::tear
