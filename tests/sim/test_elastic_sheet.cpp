@@ -516,3 +516,39 @@ TEST(ElasticSheet, HingeFoldedPastPiUnfoldsTheWayItCame) {
   EXPECT_NEAR(sheet.hingeAngle(0), 0.0, 1e-6);
   EXPECT_LT(sheet.bendingEnergy(), 1e-15);
 }
+
+// Issue 6 (tearing, thesis 3.3.3): the membrane force of each triangle on a
+// vertex is minus its energy gradient; summed, they are minus the sheet's
+// membrane energy gradient at that vertex (checked by central differences),
+// and a sheet stretched along X pulls its right edge back to the left.
+TEST(ElasticSheet, MembraneForcesOnAVertexAreMinusTheEnergyGradient) {
+  mesh::SheetMesh m = mesh::makeRectangleSheet(0.04, 0.04, 0.01);
+  mesh::placePattern(m, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
+  for (Vec3& x : m.positions) x = Vec3(1.01 * x.x(), x.y(), 0.002 * std::sin(40.0 * x.y()));
+  ElasticSheet sheet(m, officePaper(), SimParams{});
+  const int inner = mesh::nearestPatternVertex(m, Vec2(0.02, 0.02));
+  const int right = mesh::nearestPatternVertex(m, Vec2(0.04, 0.02));
+  for (const int v : {inner, right}) {
+    const auto forces = sheet.membraneForcesOn(v);
+    EXPECT_GE(forces.size(), 2u);
+    Vec3 total = Vec3::Zero();
+    for (const auto& f : forces) total += f.force;
+    Vec3 numeric;
+    for (int c = 0; c < 3; ++c) {
+      const double h = 1e-7;
+      std::vector<Vec3> x = m.positions;
+      x[static_cast<std::size_t>(v)][c] += h;
+      sheet.setPositions(x);
+      const double plus = sheet.membraneEnergy();
+      x[static_cast<std::size_t>(v)][c] -= 2.0 * h;
+      sheet.setPositions(x);
+      numeric[c] = -(plus - sheet.membraneEnergy()) / (2.0 * h);
+    }
+    sheet.setPositions(m.positions);
+    EXPECT_LT((total - numeric).norm(), 1e-6 * numeric.norm() + 1e-9) << "vertex " << v;
+  }
+  Vec3 pull = Vec3::Zero();
+  for (const auto& f : sheet.membraneForcesOn(right)) pull += f.force;
+  EXPECT_LT(pull.x(), 0.0) << "the stretched sheet pulls its right edge back";
+  EXPECT_THROW(sheet.membraneForcesOn(-1), std::out_of_range);
+}

@@ -3,10 +3,12 @@
 // of the tip's forces into two pulls, and the detail path.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <numbers>
 
+#include "crumple/tear/candidates.hpp"
 #include "crumple/tear/detail_path.hpp"
 #include "crumple/tear/fiber_texture.hpp"
 #include "crumple/tear/griffith.hpp"
@@ -176,6 +178,77 @@ TEST(DetailPath, RunsFromTipToTipRougherThanTheStraightSegment) {
   straight.blend = 1.0;
   const auto path = detailPath(fibers, Vec2(0.02, 0.03), Vec2(0.04, 0.03), straight);
   EXPECT_NEAR(pathLength(path), 0.02, 0.5e-3) << "two texels";
+}
+
+// A 4 x 4 cm sheet of 1 cm cells, without the triangles whose centroid
+// lies in `cut` (a notch or a hole).
+template <typename Cut>
+mesh::SheetMesh sheetWithout(Cut cut) {
+  mesh::SheetMesh m = mesh::makeRectangleSheet(0.04, 0.04, 0.01);
+  std::vector<std::array<int, 3>> kept;
+  for (const auto& t : m.triangles) {
+    const Vec2 c =
+        (m.pattern[static_cast<std::size_t>(t[0])] + m.pattern[static_cast<std::size_t>(t[1])] +
+         m.pattern[static_cast<std::size_t>(t[2])]) /
+        3.0;
+    if (!cut(c)) kept.push_back(t);
+  }
+  m.triangles = kept;
+  m.regionOfTriangle.assign(kept.size(), 0);
+  return m;
+}
+
+double loopArea(const mesh::SheetMesh& m, const std::vector<int>& loop) {
+  double area = 0.0;
+  for (std::size_t i = 0; i < loop.size(); ++i) {
+    const Vec2& a = m.pattern[static_cast<std::size_t>(loop[i])];
+    const Vec2& b = m.pattern[static_cast<std::size_t>(loop[(i + 1) % loop.size()])];
+    area += 0.5 * (a.x() * b.y() - a.y() * b.x());
+  }
+  return area;
+}
+
+TEST(TearCandidates, BoundaryLoopsRunWithTheSheetOnTheirLeft) {
+  const mesh::SheetMesh square = mesh::makeRectangleSheet(0.04, 0.04, 0.01);
+  const auto loops = boundaryLoops(square);
+  ASSERT_EQ(loops.size(), 1u);
+  EXPECT_EQ(loops[0].size(), 16u) << "4 sides of 4 cells";
+  EXPECT_NEAR(loopArea(square, loops[0]), 0.0016, 1e-15) << "counter-clockwise around the sheet";
+  EXPECT_TRUE(inwardCorners(square, 0.1).empty()) << "a rectangle has no inward corner";
+  // A 2 x 2 cm hole in the middle: a second loop, clockwise, four inward corners.
+  const mesh::SheetMesh holed = sheetWithout(
+      [](const Vec2& c) { return c.x() > 0.01 && c.x() < 0.03 && c.y() > 0.01 && c.y() < 0.03; });
+  const auto holeLoops = boundaryLoops(holed);
+  ASSERT_EQ(holeLoops.size(), 2u);
+  EXPECT_NEAR(loopArea(holed, holeLoops[0]) + loopArea(holed, holeLoops[1]), 0.0016 - 0.0004,
+              1e-15);
+  EXPECT_EQ(inwardCorners(holed, 0.1).size(), 4u);
+}
+
+TEST(TearCandidates, ANotchsRootAndTheBordersOfHeldAreasAreCandidates) {
+  // An L: the upper right quadrant cut away; its inner corner (2, 2) cm is
+  // the only inward corner.
+  const mesh::SheetMesh l =
+      sheetWithout([](const Vec2& c) { return c.x() > 0.02 && c.y() > 0.02; });
+  const int root = mesh::nearestPatternVertex(l, Vec2(0.02, 0.02));
+  EXPECT_EQ(inwardCorners(l, 0.1), std::vector<int>{root});
+  // A handle holds the corner (0, 0) and its two boundary neighbours; a
+  // junction and a tip are given.
+  std::vector<char> held(l.vertexCount(), 0);
+  for (const Vec2& p : {Vec2(0, 0), Vec2(0.01, 0), Vec2(0, 0.01)})
+    held[static_cast<std::size_t>(mesh::nearestPatternVertex(l, p))] = 1;
+  const int tip = mesh::nearestPatternVertex(l, Vec2(0.04, 0.01));
+  const int junction = mesh::nearestPatternVertex(l, Vec2(0.01, 0.04));
+  const auto candidates = tearCandidates(l, {tip}, {junction, tip}, held, 0.1);
+  std::vector<TearCandidate> expected{
+      {tip, CandidateKind::Tip},
+      {junction, CandidateKind::Junction},
+      {mesh::nearestPatternVertex(l, Vec2(0.02, 0)), CandidateKind::HandleBorder},
+      {mesh::nearestPatternVertex(l, Vec2(0, 0.02)), CandidateKind::HandleBorder},
+      {root, CandidateKind::InwardCorner}};
+  std::sort(expected.begin(), expected.end(),
+            [](const TearCandidate& a, const TearCandidate& b) { return a.vertex < b.vertex; });
+  EXPECT_EQ(candidates, expected);
 }
 
 }  // namespace

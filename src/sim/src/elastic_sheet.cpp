@@ -1315,6 +1315,25 @@ void ElasticSheet::setContacts(ContactOptions options) {
   impl_->lastContacts.clear();
 }
 
+std::vector<ElasticSheet::TriangleForce> ElasticSheet::membraneForcesOn(int vertex) const {
+  const Impl& m = *impl_;
+  if (vertex < 0 || static_cast<std::size_t>(vertex) >= m.vertexCount)
+    throw std::out_of_range("ElasticSheet::membraneForcesOn: no vertex " + std::to_string(vertex));
+  std::vector<TriangleForce> out;
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    const auto& tri = m.triangles[t];
+    for (int a = 0; a < 3; ++a) {
+      if (tri[static_cast<std::size_t>(a)] != vertex) continue;
+      Vec9 gradient;
+      sim::membraneEnergy(
+          m.x[static_cast<std::size_t>(tri[0])], m.x[static_cast<std::size_t>(tri[1])],
+          m.x[static_cast<std::size_t>(tri[2])], m.triangleRests[t], m.moduli, &gradient);
+      out.push_back({static_cast<int>(t), -gradient.segment<3>(3 * a)});
+    }
+  }
+  return out;
+}
+
 long ElasticSheet::contactVertexSteps() const { return impl_->contactVertexSteps; }
 const std::vector<ContactSample>& ElasticSheet::contacts() const { return impl_->lastContacts; }
 

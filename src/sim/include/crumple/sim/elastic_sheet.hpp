@@ -160,6 +160,17 @@ class ElasticSheet {
   // Max over triangles of the largest absolute principal Green strain.
   double maxMembraneStrain() const;
 
+  // The membrane (Green strain) force each triangle around `vertex` exerts
+  // on it at the current positions: minus the gradient of that triangle's
+  // membrane energy with respect to the vertex (N). What a tear tip feels
+  // from the elastic step (thesis 3.3.3); bending forces, orders of
+  // magnitude weaker, are left out as there. Sorted by triangle.
+  struct TriangleForce {
+    int triangle = -1;
+    Vec3 force = Vec3::Zero();
+  };
+  std::vector<TriangleForce> membraneForcesOn(int vertex) const;
+
   // Additions beyond the original interface (diagnostics and tests).
   double hingeRestAngle(std::size_t hinge) const;
   double hingeStiffnessFactor(std::size_t hinge) const;

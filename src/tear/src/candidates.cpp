@@ -1,0 +1,93 @@
+#include "crumple/tear/candidates.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <stdexcept>
+
+namespace crumple::tear {
+
+std::vector<std::vector<int>> boundaryLoops(const mesh::SheetMesh& mesh) {
+  // Each boundary edge, oriented as its triangle runs it (counter-clockwise
+  // triangles: the sheet on the edge's left).
+  std::map<int, int> next;
+  for (const mesh::MeshEdge& e : mesh::buildEdges(mesh)) {
+    if (e.interior()) continue;
+    const auto& t = mesh.triangles[static_cast<std::size_t>(e.triangles[0])];
+    int from = e.v[0], to = e.v[1];
+    for (int k = 0; k < 3; ++k)
+      if (t[static_cast<std::size_t>(k)] == e.v[1] &&
+          t[static_cast<std::size_t>((k + 1) % 3)] == e.v[0])
+        std::swap(from, to);
+    if (!next.emplace(from, to).second)
+      throw std::invalid_argument("boundaryLoops: two boundary loops touch at vertex " +
+                                  std::to_string(from));
+  }
+  std::vector<std::vector<int>> loops;
+  while (!next.empty()) {
+    std::vector<int> loop;
+    int v = next.begin()->first;  // the lowest vertex left
+    while (true) {
+      const auto it = next.find(v);
+      if (it == next.end()) break;
+      loop.push_back(v);
+      v = it->second;
+      next.erase(it);
+    }
+    if (v != loop.front())
+      throw std::invalid_argument("boundaryLoops: a boundary that does not close");
+    loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+std::vector<int> inwardCorners(const mesh::SheetMesh& mesh, double minAngle) {
+  std::vector<int> out;
+  for (const auto& loop : boundaryLoops(mesh)) {
+    const std::size_t n = loop.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec2& prev = mesh.pattern[static_cast<std::size_t>(loop[(i + n - 1) % n])];
+      const Vec2& here = mesh.pattern[static_cast<std::size_t>(loop[i])];
+      const Vec2& next = mesh.pattern[static_cast<std::size_t>(loop[(i + 1) % n])];
+      const Vec2 a = here - prev, b = next - here;
+      // The sheet is on the left: a right turn (negative cross) is reflex.
+      const double turn = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+      if (-turn > minAngle) out.push_back(loop[i]);  // interior angle = pi - turn
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<TearCandidate> tearCandidates(const mesh::SheetMesh& mesh, const std::vector<int>& tips,
+                                          const std::vector<int>& junctions,
+                                          const std::vector<char>& held, double minInwardAngle) {
+  if (held.size() != mesh.vertexCount())
+    throw std::invalid_argument("tearCandidates: held must have one entry per vertex");
+  std::map<int, CandidateKind> kind;
+  const auto add = [&](int v, CandidateKind k) {
+    if (v < 0 || static_cast<std::size_t>(v) >= mesh.vertexCount())
+      throw std::invalid_argument("tearCandidates: vertex " + std::to_string(v) + " out of range");
+    kind.emplace(v, k);  // the first kind given wins
+  };
+  for (int v : tips) add(v, CandidateKind::Tip);
+  for (int v : junctions) add(v, CandidateKind::Junction);
+  for (const auto& loop : boundaryLoops(mesh)) {
+    const std::size_t n = loop.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto v = static_cast<std::size_t>(loop[i]);
+      const auto before = static_cast<std::size_t>(loop[(i + n - 1) % n]);
+      const auto after = static_cast<std::size_t>(loop[(i + 1) % n]);
+      if (held[v] == 0 && (held[before] != 0 || held[after] != 0))
+        add(loop[i], CandidateKind::HandleBorder);
+    }
+  }
+  for (int v : inwardCorners(mesh, minInwardAngle)) add(v, CandidateKind::InwardCorner);
+  std::vector<TearCandidate> out;
+  out.reserve(kind.size());
+  for (const auto& [v, k] : kind) out.push_back({v, k});
+  return out;
+}
+
+}  // namespace crumple::tear
