@@ -12,6 +12,7 @@
 #include "crumple/tear/detail_path.hpp"
 #include "crumple/tear/fiber_texture.hpp"
 #include "crumple/tear/griffith.hpp"
+#include "crumple/tear/lip_masks.hpp"
 
 namespace crumple::tear {
 namespace {
@@ -249,6 +250,59 @@ TEST(TearCandidates, ANotchsRootAndTheBordersOfHeldAreasAreCandidates) {
   std::sort(expected.begin(), expected.end(),
             [](const TearCandidate& a, const TearCandidate& b) { return a.vertex < b.vertex; });
   EXPECT_EQ(candidates, expected);
+}
+
+TEST(LipMasks, EveryPixelIsOnTheSideOfTheDetailPathItLooksToBeOn) {
+  // A straight path: the left side is where the cross product is positive.
+  PixelGrid grid;
+  grid.width = 48;
+  grid.height = 40;
+  const std::vector<Vec2> line{Vec2(0.0011, 0.0013), Vec2(0.0093, 0.0071)};
+  const auto straight = leftOfPath(line, grid);
+  const Vec2 d = line[1] - line[0];
+  for (int j = 0; j < grid.height; ++j)
+    for (int i = 0; i < grid.width; ++i) {
+      const Vec2 r = grid.centre(i, j) - line[0];
+      EXPECT_EQ(straight[static_cast<std::size_t>(j * grid.width + i)],
+                d.x() * r.y() - d.y() * r.x() > 0.0 ? 1 : 0)
+          << i << ", " << j;
+    }
+  // A detail path through the fibers, on a grid twice as fine as its
+  // texels: every pixel clearly nearest to the inside of one segment (more
+  // than half a pixel from the path) is on that segment's side.
+  const FiberTexture fibers(Vec2::Zero(), Vec2(0.03, 0.03), FiberTextureParams{});
+  const auto path = detailPath(fibers, Vec2(0.005, 0.012), Vec2(0.025, 0.018), DetailPathParams{});
+  ASSERT_GT(pathLength(path), 1.15 * 0.0209);
+  PixelGrid fine;
+  fine.pixelSize = 1.25e-4;
+  fine.width = fine.height = 240;
+  const auto mask = leftOfPath(path, fine);
+  long checked = 0, left = 0;
+  for (int j = 0; j < fine.height; ++j)
+    for (int i = 0; i < fine.width; ++i) {
+      const Vec2 q = fine.centre(i, j);
+      double best = 1.0;
+      int side = -1;
+      for (std::size_t k = 0; k + 1 < path.size(); ++k) {
+        const Vec2 a = path[k], b = path[k + 1], ab = b - a;
+        const double t = (q - a).dot(ab) / ab.squaredNorm();
+        const double dist = (q - (a + std::clamp(t, 0.0, 1.0) * ab)).norm();
+        if (dist < best) {
+          best = dist;
+          const bool interior = t > 0.05 && t < 0.95;
+          side = interior ? (ab.x() * (q - a).y() - ab.y() * (q - a).x() > 0.0 ? 1 : 0) : -1;
+        }
+      }
+      if (side < 0 || best < 0.5 * fine.pixelSize || best > 4.0 * fine.pixelSize) continue;
+      ++checked;
+      left += side;
+      EXPECT_EQ(mask[static_cast<std::size_t>(j * fine.width + i)], side) << i << ", " << j;
+    }
+  std::cout << "[ measure ] " << checked << " pixels along the path checked, " << left
+            << " of them left of it\n";
+  EXPECT_GT(checked, 200);
+  EXPECT_GT(left, checked / 4);
+  EXPECT_LT(left, 3 * checked / 4);
 }
 
 }  // namespace
