@@ -6,13 +6,16 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <map>
 #include <numbers>
 
+#include "crumple/sim/elastic_sheet.hpp"
 #include "crumple/tear/candidates.hpp"
 #include "crumple/tear/detail_path.hpp"
 #include "crumple/tear/fiber_texture.hpp"
 #include "crumple/tear/griffith.hpp"
 #include "crumple/tear/lip_masks.hpp"
+#include "crumple/tear/tip_pulls.hpp"
 
 namespace crumple::tear {
 namespace {
@@ -303,6 +306,100 @@ TEST(LipMasks, EveryPixelIsOnTheSideOfTheDetailPathItLooksToBeOn) {
   EXPECT_GT(checked, 200);
   EXPECT_GT(left, checked / 4);
   EXPECT_LT(left, 3 * checked / 4);
+}
+
+// A 4 x 4 cm sheet (2.5 mm cells) slit from the bottom edge up to its
+// middle along x = 2 cm: the slit's lips are separate vertices, its tip
+// (2, 1) cm is shared. `peel` turns the flaps below y = 1 cm up (left) and
+// down (right) about that line by this angle; `stretch` lengthens them
+// along their length; `spread` moves them apart along X instead.
+struct Slit {
+  mesh::SheetMesh mesh;
+  int tip = -1;
+};
+Slit slitSheet(double peel, double stretch, double spread) {
+  Slit s;
+  s.mesh = mesh::makeRectangleSheet(0.04, 0.04, 0.0025);
+  mesh::placePattern(s.mesh, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
+  mesh::SheetMesh& m = s.mesh;
+  std::map<int, int> twin;  // slit vertex -> its copy on the left lip
+  for (auto& t : m.triangles) {
+    const Vec2 c =
+        (m.pattern[static_cast<std::size_t>(t[0])] + m.pattern[static_cast<std::size_t>(t[1])] +
+         m.pattern[static_cast<std::size_t>(t[2])]) /
+        3.0;
+    if (!(c.x() < 0.02 && c.y() < 0.01)) continue;
+    for (int& v : t) {
+      const Vec2 p = m.pattern[static_cast<std::size_t>(v)];
+      if (std::abs(p.x() - 0.02) > 1e-12 || !(p.y() < 0.01 - 1e-12)) continue;
+      auto [it, added] = twin.emplace(v, static_cast<int>(m.pattern.size()));
+      if (added) {
+        m.pattern.push_back(p);
+        m.positions.push_back(m.positions[static_cast<std::size_t>(v)]);
+      }
+      v = it->second;
+    }
+  }
+  s.tip = mesh::nearestPatternVertex(m, Vec2(0.02, 0.01));
+  // Left lip: the copies and every vertex left of the slit.
+  std::vector<char> left(m.vertexCount(), 0);
+  for (const auto& t : m.triangles) {
+    const Vec2 c =
+        (m.pattern[static_cast<std::size_t>(t[0])] + m.pattern[static_cast<std::size_t>(t[1])] +
+         m.pattern[static_cast<std::size_t>(t[2])]) /
+        3.0;
+    if (c.x() < 0.02)
+      for (int v : t) left[static_cast<std::size_t>(v)] = 1;
+  }
+  for (std::size_t v = 0; v < m.vertexCount(); ++v) {
+    const Vec2 p = m.pattern[v];
+    if (!(p.y() < 0.01 - 1e-12)) continue;
+    const double below = stretch * (0.01 - p.y());
+    const bool isLeft = left[v] != 0 && !(p.x() > 0.02 + 1e-12);
+    const double a = isLeft ? peel : -peel;
+    const double dx = isLeft ? -spread : spread;
+    m.positions[v] =
+        Vec3(p.x() + dx * below / 0.01, 0.01 - below * std::cos(a), below * std::sin(a));
+  }
+  return s;
+}
+
+TipPulls pullsAtTip(const Slit& s) {
+  sim::ElasticSheet sheet(s.mesh, sim::Material{}, sim::SimParams{});
+  std::vector<TriangleForce> forces;
+  for (const auto& f : sheet.membraneForcesOn(s.tip)) forces.push_back({f.triangle, f.force});
+  return tipPulls(s.mesh, s.tip, forces, boundaryBisector(s.mesh, s.tip));
+}
+
+TEST(TipPulls, PeeledFlapsTearTheSlitOnwardAndReleaseMoreThanFannedOnes) {
+  // The slit's tip: the boundary's bisector points up the slit, into the sheet.
+  const Slit flat = slitSheet(0.0, 1.0, 0.0);
+  EXPECT_TRUE(boundaryBisector(flat.mesh, flat.tip).isApprox(Vec2(0, 1), 1e-12));
+  // Flaps peeled apart (up and down by 60 deg) and pulled taut (1 %): both
+  // pulls point back down the flaps, the tear runs on up the slit and
+  // releases nearly all of them (Roman's tearing, theta near 0).
+  const TipPulls peeled = pullsAtTip(slitSheet(std::numbers::pi / 3.0, 1.01, 0.0));
+  const Propagation p = propagation(peeled.left, peeled.right);
+  std::cout << "[ measure ] peeled: pulls " << peeled.left.transpose() << " | "
+            << peeled.right.transpose() << " N, theta " << p.angle << " rad, E_r "
+            << p.energyRelease << " N, direction " << p.direction.transpose() << "\n";
+  EXPECT_TRUE(peeled.clusters.converged);
+  EXPECT_GT(peeled.left.norm(), 0.0);
+  EXPECT_GT(peeled.right.norm(), 0.0);
+  EXPECT_LT(p.angle, 0.5);
+  EXPECT_GT(p.direction.dot(Vec2(0, 1)), 0.95) << "up the slit, into the sheet";
+  EXPECT_GT(p.energyRelease, 0.8 * (peeled.left.norm() + peeled.right.norm()));
+  // The same flaps fanned apart in the plane (their bottom corners moved
+  // 1 mm outward): the pulls point to the flaps' far corners, wide apart,
+  // and release a smaller part of themselves (cos(theta / 2)).
+  const TipPulls apart = pullsAtTip(slitSheet(0.0, 1.0, 0.001));
+  const Propagation q = propagation(apart.left, apart.right);
+  const double fraction = q.energyRelease / (apart.left.norm() + apart.right.norm());
+  std::cout << "[ measure ] fanned in the plane: theta " << q.angle << " rad, E_r "
+            << q.energyRelease << " N, " << fraction << " of the pulls\n";
+  EXPECT_GT(q.angle, 1.0);
+  EXPECT_LT(fraction, 0.8);
+  EXPECT_GT(q.direction.dot(Vec2(0, 1)), 0.95) << "still up the slit, by symmetry";
 }
 
 }  // namespace

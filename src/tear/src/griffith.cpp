@@ -42,10 +42,11 @@ ForceClusters clusterTipForces(const std::vector<Vec3>& forces, const Vec3& norm
   for (int i = 0; i < std::max(1, maxIterations); ++i) {
     const Vec3 d = b.cross(n);
     Vec3 left = Vec3::Zero(), right = Vec3::Zero();
-    for (const Vec3& f : forces) {
-      const double side = f.dot(d);
-      if (side > 0.0) left += f;
-      if (side < 0.0) right += f;
+    out.side.assign(forces.size(), 0);
+    for (std::size_t k = 0; k < forces.size(); ++k) {
+      const double side = forces[k].dot(d);
+      if (side > 0.0) left += forces[k], out.side[k] = 1;
+      if (side < 0.0) right += forces[k], out.side[k] = -1;
     }
     out.left = left;
     out.right = right;

@@ -24,6 +24,7 @@ double fractureEnergy(double resistance, double fibers, double damage);
 struct ForceClusters {
   Vec3 left = Vec3::Zero();
   Vec3 right = Vec3::Zero();
+  std::vector<int> side;  // per force: +1 left, -1 right, 0 on the split plane
   int iterations = 0;
   bool converged = false;
 };
