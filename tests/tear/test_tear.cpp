@@ -15,6 +15,7 @@
 #include "crumple/tear/fiber_texture.hpp"
 #include "crumple/tear/griffith.hpp"
 #include "crumple/tear/lip_masks.hpp"
+#include "crumple/tear/tear_step.hpp"
 #include "crumple/tear/tip_pulls.hpp"
 
 namespace crumple::tear {
@@ -400,6 +401,37 @@ TEST(TipPulls, PeeledFlapsTearTheSlitOnwardAndReleaseMoreThanFannedOnes) {
   EXPECT_GT(q.angle, 1.0);
   EXPECT_LT(fraction, 0.8);
   EXPECT_GT(q.direction.dot(Vec2(0, 1)), 0.95) << "still up the slit, by symmetry";
+}
+
+TEST(TearStep, TheSlitsTipTearsWhenTheReleaseBeatsTheFractureEnergy) {
+  const auto run = [](const Slit& s, const TearParams& params) {
+    sim::ElasticSheet sheet(s.mesh, sim::Material{}, sim::SimParams{});
+    const FiberTexture fibers(Vec2::Zero(), Vec2(0.04, 0.04), FiberTextureParams{});
+    const VertexForces forces = [&sheet](int v) {
+      std::vector<TriangleForce> out;
+      for (const auto& f : sheet.membraneForcesOn(v)) out.push_back({f.triangle, f.force});
+      return out;
+    };
+    return testCandidates(s.mesh, fibers, {s.tip}, {}, std::vector<char>(s.mesh.vertexCount(), 0),
+                          forces, params);
+  };
+  const Slit peeled = slitSheet(std::numbers::pi / 3.0, 1.01, 0.0);
+  const auto tests = run(peeled, TearParams{});
+  ASSERT_EQ(tests.size(), 1u) << "the slit's tip is the only candidate (the corners are convex)";
+  const CandidateTest& t = tests[0];
+  EXPECT_EQ(t.candidate, (TearCandidate{peeled.tip, CandidateKind::Tip}));
+  EXPECT_TRUE(t.tears);
+  const Vec2 from = peeled.mesh.pattern[static_cast<std::size_t>(peeled.tip)];
+  EXPECT_TRUE(
+      t.next.isApprox(from + 1e-3 * t.propagation.energyRelease * t.propagation.direction, 1e-12));
+  EXPECT_GT(t.next.y(), from.y());
+  // A tougher paper (E_f beyond the release) holds; so does an unstrained sheet.
+  TearParams tough;
+  tough.resistance = 1e3;
+  EXPECT_FALSE(run(peeled, tough)[0].tears);
+  EXPECT_EQ(run(peeled, tough)[0].next, from);
+  const Slit relaxed = slitSheet(0.0, 1.0, 0.0);
+  EXPECT_FALSE(run(relaxed, TearParams{})[0].tears);
 }
 
 }  // namespace
