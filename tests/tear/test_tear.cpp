@@ -11,6 +11,7 @@
 
 #include "crumple/sim/elastic_sheet.hpp"
 #include "crumple/tear/candidates.hpp"
+#include "crumple/tear/cut.hpp"
 #include "crumple/tear/detail_path.hpp"
 #include "crumple/tear/fiber_texture.hpp"
 #include "crumple/tear/griffith.hpp"
@@ -432,6 +433,72 @@ TEST(TearStep, TheSlitsTipTearsWhenTheReleaseBeatsTheFractureEnergy) {
   EXPECT_EQ(run(peeled, tough)[0].next, from);
   const Slit relaxed = slitSheet(0.0, 1.0, 0.0);
   EXPECT_FALSE(run(relaxed, TearParams{})[0].tears);
+}
+
+// Whether the open segment (a, b) passes through the inside of triangle t.
+bool crossesInside(const mesh::SheetMesh& m, const std::array<int, 3>& t, const Vec2& a,
+                   const Vec2& b) {
+  // Sample the segment densely: any sample strictly inside the triangle.
+  const Vec2 p0 = m.pattern[static_cast<std::size_t>(t[0])];
+  const Vec2 p1 = m.pattern[static_cast<std::size_t>(t[1])];
+  const Vec2 p2 = m.pattern[static_cast<std::size_t>(t[2])];
+  const auto cross = [](const Vec2& u, const Vec2& v) { return u.x() * v.y() - u.y() * v.x(); };
+  const double area = cross(p1 - p0, p2 - p0);
+  for (int k = 1; k < 2000; ++k) {
+    const Vec2 q = a + (b - a) * (k / 2000.0);
+    const double w1 = cross(q - p0, p2 - p0) / area, w2 = cross(p1 - p0, q - p0) / area;
+    const double w0 = 1.0 - w1 - w2;
+    if (w0 > 1e-6 && w1 > 1e-6 && w2 > 1e-6) return true;
+  }
+  return false;
+}
+
+TEST(Cut, ATearsAdvanceBecomesTwoLipsThatNoTriangleCrosses) {
+  for (const Vec2& to : {Vec2(0.0213, 0.0137), Vec2(0.031, 0.017), Vec2(0.02, 0.015)}) {
+    mesh::SheetMesh m = mesh::makeRectangleSheet(0.04, 0.04, 0.005);
+    mesh::placePattern(m, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
+    const int from = mesh::nearestPatternVertex(m, Vec2(0.02, 0.0));
+    const Vec2 start = m.pattern[static_cast<std::size_t>(from)];
+    const std::size_t before = m.vertexCount();
+    std::cout << "cut to " << to.transpose() << "\n";
+    const CutResult cut = cutAlong(m, from, to);
+    EXPECT_EQ(mesh::validate(m), "") << to.transpose();
+    // The tip is the new point; every other chain vertex has a twin.
+    EXPECT_TRUE(m.pattern[static_cast<std::size_t>(cut.tip)].isApprox(to, 1e-12));
+    EXPECT_EQ(cut.twins.size(), cut.chain.size() - 1);
+    EXPECT_GT(m.vertexCount(), before);
+    for (std::size_t i = 0; i < cut.twins.size(); ++i)
+      EXPECT_EQ(m.pattern[static_cast<std::size_t>(cut.twins[i])],
+                m.pattern[static_cast<std::size_t>(cut.chain[i])]);
+    // The sheet keeps its area, no triangle crosses the cut, and the
+    // outline now runs up one lip and down the other.
+    double area = 0.0;
+    for (const auto& t : m.triangles) {
+      const Vec2 a = m.pattern[static_cast<std::size_t>(t[0])];
+      const Vec2 b = m.pattern[static_cast<std::size_t>(t[1])];
+      const Vec2 c = m.pattern[static_cast<std::size_t>(t[2])];
+      area += 0.5 * ((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
+      EXPECT_FALSE(crossesInside(m, t, start, to));
+    }
+    EXPECT_NEAR(area, 0.0016, 1e-15);
+    const auto loops = boundaryLoops(m);
+    ASSERT_EQ(loops.size(), 1u);
+    double perimeter = 0.0;
+    for (std::size_t i = 0; i < loops[0].size(); ++i)
+      perimeter += (m.pattern[static_cast<std::size_t>(loops[0][(i + 1) % loops[0].size()])] -
+                    m.pattern[static_cast<std::size_t>(loops[0][i])])
+                       .norm();
+    EXPECT_NEAR(perimeter, 0.16 + 2.0 * (to - start).norm(), 1e-12) << to.transpose();
+    // The new tip is the outline's sharpest inward corner: a candidate.
+    EXPECT_EQ(inwardCorners(m, 0.1), std::vector<int>{cut.tip});
+  }
+  mesh::SheetMesh m = mesh::makeRectangleSheet(0.04, 0.04, 0.005);
+  EXPECT_THROW(cutAlong(m, mesh::nearestPatternVertex(m, Vec2(0.02, 0.02)), Vec2(0.02, 0.03)),
+               std::invalid_argument)
+      << "from an interior vertex";
+  EXPECT_THROW(cutAlong(m, mesh::nearestPatternVertex(m, Vec2(0.02, 0.0)), Vec2(0.02, 0.05)),
+               std::invalid_argument)
+      << "out of the sheet";
 }
 
 }  // namespace

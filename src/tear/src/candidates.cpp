@@ -50,10 +50,14 @@ std::vector<int> inwardCorners(const mesh::SheetMesh& mesh, double minAngle) {
       const Vec2& prev = mesh.pattern[static_cast<std::size_t>(loop[(i + n - 1) % n])];
       const Vec2& here = mesh.pattern[static_cast<std::size_t>(loop[i])];
       const Vec2& next = mesh.pattern[static_cast<std::size_t>(loop[(i + 1) % n])];
-      const Vec2 a = here - prev, b = next - here;
-      // The sheet is on the left: a right turn (negative cross) is reflex.
-      const double turn = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
-      if (-turn > minAngle) out.push_back(loop[i]);  // interior angle = pi - turn
+      // The sheet is on the left of the loop: its angle at `here` runs
+      // counter-clockwise from the outgoing edge to the incoming one; two
+      // edges along the same line are the tip of a slit (2 pi).
+      const Vec2 out1 = next - here, in1 = prev - here;
+      double interior = std::atan2(out1.x() * in1.y() - out1.y() * in1.x(), out1.dot(in1));
+      if (interior < 0.0) interior += 2.0 * std::numbers::pi;
+      if (interior < 1e-9) interior = 2.0 * std::numbers::pi;
+      if (interior > std::numbers::pi + minAngle) out.push_back(loop[i]);
     }
   }
   std::sort(out.begin(), out.end());
