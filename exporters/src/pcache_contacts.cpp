@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "block_reader.hpp"
 #include "byte_encoder.hpp"
 #include "crumple/core/error.hpp"
 
@@ -30,62 +31,8 @@ using detail::Encoder;
 constexpr std::size_t kMinColliderBytes = 4 + 4 + 8;
 constexpr std::size_t kContactBytes = 4 + 4 + 4 + 4;
 
-// Reads a block; errors name the block, the record being read (at()) and
-// the field. Messages are built only on failure.
-class Reader {
- public:
-  Reader(const Bytes& bytes, const char* block) : bytes_(bytes), block_(block) {}
-
-  std::uint32_t u32(const char* what) { return static_cast<std::uint32_t>(get(4, what)); }
-  int i32(const char* what) { return static_cast<std::int32_t>(u32(what)); }
-  float f32(const char* what) { return std::bit_cast<float>(u32(what)); }
-  double f64(const char* what) { return std::bit_cast<double>(get(8, what)); }
-  // A u32 count of records of at least `minBytes` each, checked against what
-  // is left so that a damaged count cannot trigger a huge allocation.
-  std::size_t count(std::size_t minBytes, const char* what) {
-    const std::size_t n = u32(what);
-    if (n > remaining() / minBytes)
-      fail(std::string(what) + " " + std::to_string(n) + " runs past the end of the block (" +
-           std::to_string(remaining()) + " bytes left)");
-    return n;
-  }
-  std::string str(const char* what) {
-    const std::size_t n = u32(what);
-    if (n > remaining())
-      fail(std::string(what) + ": length " + std::to_string(n) + " runs past the end of the block");
-    std::string s(reinterpret_cast<const char*>(bytes_.data() + pos_), n);
-    pos_ += n;
-    return s;
-  }
-  // The record the next reads belong to, for messages.
-  void at(const char* kind, std::size_t index) {
-    kind_ = kind;
-    index_ = index;
-  }
-  void expectEnd() {
-    kind_ = nullptr;
-    if (remaining() != 0) fail(std::to_string(remaining()) + " trailing bytes");
-  }
-  [[noreturn]] void fail(const std::string& problem) const {
-    std::string where = kind_ ? std::string(kind_) + " " + std::to_string(index_) + ": " : "";
-    throw CorruptDataError(std::string("pcache ") + block_ + " sub-block: " + where + problem);
-  }
-
- private:
-  std::size_t remaining() const { return bytes_.size() - pos_; }
-  std::uint64_t get(int n, const char* what) {
-    if (static_cast<std::size_t>(n) > remaining()) fail(std::string(what) + " truncated");
-    std::uint64_t v = 0;
-    for (int k = 0; k < n; ++k) v |= static_cast<std::uint64_t>(bytes_[pos_ + k]) << (8 * k);
-    pos_ += static_cast<std::size_t>(n);
-    return v;
-  }
-  const Bytes& bytes_;
-  const char* block_;
-  const char* kind_ = nullptr;
-  std::size_t index_ = 0;
-  std::size_t pos_ = 0;
-};
+using detail::findOneBlock;
+using Reader = detail::SubBlockReader;
 
 bool finiteNonNegative(double v) { return std::isfinite(v) && v >= 0.0; }
 
@@ -93,21 +40,6 @@ std::string valueText(double v) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.9g", v);
   return buf;
-}
-
-std::string tagName(const std::array<char, 4>& tag) { return std::string(tag.data(), tag.size()); }
-
-// The one block with `tag`, or null; two are malformed.
-const ExtensionBlock* findOne(const std::vector<ExtensionBlock>& blocks,
-                              const std::array<char, 4>& tag) {
-  const ExtensionBlock* found = nullptr;
-  for (const auto& b : blocks) {
-    if (b.tag != tag) continue;
-    if (found)
-      throw CorruptDataError("pcache " + tagName(tag) + " sub-block: present more than once");
-    found = &b;
-  }
-  return found;
 }
 
 // The problem with a contact, or empty when it is valid.
@@ -164,7 +96,7 @@ ExtensionBlock encodeContacts(const std::vector<ContactRecord>& contacts) {
 
 std::optional<std::vector<ColliderInfo>> decodeColliders(
     const std::vector<ExtensionBlock>& headerBlocks) {
-  const ExtensionBlock* block = findOne(headerBlocks, kCollidersTag);
+  const ExtensionBlock* block = findOneBlock(headerBlocks, kCollidersTag);
   if (!block) return std::nullopt;
   Reader r(block->data, "COLL");
   std::vector<ColliderInfo> colliders(r.count(kMinColliderBytes, "collider count"));
@@ -182,7 +114,7 @@ std::optional<std::vector<ColliderInfo>> decodeColliders(
 
 std::optional<std::vector<ContactRecord>> decodeContacts(
     const std::vector<ExtensionBlock>& frameBlocks) {
-  const ExtensionBlock* block = findOne(frameBlocks, kContactsTag);
+  const ExtensionBlock* block = findOneBlock(frameBlocks, kContactsTag);
   if (!block) return std::nullopt;
   Reader r(block->data, "CONT");
   std::vector<ContactRecord> contacts(r.count(kContactBytes, "contact count"));

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "crumple/core/error.hpp"
+#include "crumple/exporters/pcache_tear.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/pipeline/shot.hpp"
 
@@ -155,12 +156,13 @@ render::PropMesh boxProp(const io::PropSpec& p) {
 }  // namespace
 
 std::vector<cache::ExtensionBlock> lookHeaderBlocks(const io::SceneSpec& scene,
-                                                   const io::AnimationScene* animation) {
+                                                    const io::AnimationScene* animation) {
   std::vector<cache::ExtensionBlock> blocks;
   if (!scene.look.texture.empty()) {
     std::ifstream in(scene.look.texture, std::ios::binary);
-    if (!in) throw InputError(scene.file, scene.look.textureLine, "paper.texture",
-                              "cannot read " + scene.look.texture);
+    if (!in)
+      throw InputError(scene.file, scene.look.textureLine, "paper.texture",
+                       "cannot read " + scene.look.texture);
     cache::ExtensionBlock b;
     b.tag = kTextureTag;
     b.data.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
@@ -208,7 +210,8 @@ std::optional<cache::ExtensionBlock> propMotionBlock(const io::SceneSpec& scene,
   for (const auto& p : scene.props) {
     if (p.node.empty()) continue;
     // The stored mesh is the node's world mesh at t = 0: carry it along.
-    const Mat4 motion = animation->worldMatrix(p.node, t) * animation->worldMatrix(p.node, 0.0).inverse();
+    const Mat4 motion =
+        animation->worldMatrix(p.node, t) * animation->worldMatrix(p.node, 0.0).inverse();
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r) w.put(motion(r, c));
   }
@@ -290,6 +293,13 @@ FrameView FrameViewBuilder::build(const cache::FrameRecord& frame) const {
   }
   fv.scene.sharpVertices = frame.singularVertices;
   fv.sheet = sheetOfFrame(frame);
+  // The frame's tear textures (docs/PCACHE.md "TEAR"), checked against its mesh.
+  if (auto tears = cache::decodeTearAtlas(frame.extensions)) {
+    if (const std::string problem = mesh::validate(*tears, fv.sheet); !problem.empty())
+      throw CorruptDataError("frame " + std::to_string(frame.frame) +
+                             " of the cache: TEAR sub-block: " + problem);
+    fv.scene.tears = std::move(*tears);
+  }
   return fv;
 }
 

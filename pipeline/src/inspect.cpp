@@ -179,6 +179,12 @@ std::string inspectText(const cache::CacheReader& reader) {
       out += "  " + std::to_string(k) + ": " + c.name + ", material " + c.material + line;
     }
   }
+  std::vector<FrameMetrics> metrics;
+  bool torn = false;  // a tears column when any frame has a tear
+  for (std::size_t i = 0; i < reader.frameCount(); ++i) {
+    metrics.push_back(measure(reader, reader.readFrame(i)));
+    torn = torn || metrics.back().tears > 0;
+  }
   std::snprintf(line, sizeof line, "%6s %9s %8s %9s %10s %8s %10s %9s %12s", "frame", "time[s]",
                 "verts", "tris", "c_mean", "n_comp", "max_strain", "dihedral", "handle_err[m]");
   out += line;
@@ -186,15 +192,19 @@ std::string inspectText(const cache::CacheReader& reader) {
     std::snprintf(line, sizeof line, " %8s %14s", "contacts", "max_slide[m/s]");
     out += line;
   }
+  if (torn) out += "  tears";
   out += "\n";
-  for (std::size_t i = 0; i < reader.frameCount(); ++i) {
-    const auto m = measure(reader, reader.readFrame(i));
+  for (const FrameMetrics& m : metrics) {
     std::snprintf(line, sizeof line, "%6d %9.4f %8zu %9zu %10.3e %8.4f %10.3e %9.4f %12.3e",
                   m.frame, m.time, m.vertices, m.triangles, m.cMean, m.nComp, m.maxStrain,
                   m.maxDihedral, m.handleError);
     out += line;
     if (colliders) {
       std::snprintf(line, sizeof line, " %8zu %14.3e", m.contacts, m.maxSlideSpeed);
+      out += line;
+    }
+    if (torn) {
+      std::snprintf(line, sizeof line, " %6zu", static_cast<std::size_t>(m.tears));
       out += line;
     }
     out += "\n";

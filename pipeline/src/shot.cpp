@@ -17,6 +17,7 @@
 #include "crumple/core/error.hpp"
 #include "crumple/core/progress.hpp"
 #include "crumple/exporters/pcache_contacts.hpp"
+#include "crumple/exporters/pcache_tear.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/paper/hybrid_sheet.hpp"
 #include "crumple/paper/initial_sheet.hpp"
@@ -26,6 +27,7 @@
 #include "crumple/render/osmesa_renderer.hpp"
 #include "crumple/sim/colliders.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
+#include "crumple/tear/tear_atlas.hpp"
 #include "frame_output.hpp"
 #include "json_writer.hpp"
 
@@ -159,6 +161,23 @@ paper::InitialSheet hybridStartSheet(const io::SceneSpec& scene,
   return paper::makeFlatSheet(s.width, s.height, points, s.origin, u, v);
 }
 
+tear::TearingParams tearingParamsOf(const io::TearSpec& t) {
+  tear::TearingParams p;
+  p.griffith.resistance = t.resistance;
+  p.griffith.tipDamage = t.tipDamage;
+  p.griffith.speed = t.speed;
+  p.griffith.minInwardAngle = t.minInwardAngle;
+  p.fibers.texelSize = t.texel;
+  p.fibers.featureSize = t.fiberSize;
+  p.fibers.octaves = t.fiberOctaves;
+  p.fibers.anisotropy = t.fiberAnisotropy;
+  p.fibers.fiberDirection = t.fiberDirection;
+  p.detail.blend = t.detailBlend;
+  p.detail.stressWidth = t.stressWidth;
+  p.maxNewTearsPerFrame = t.maxNewPerFrame;
+  return p;
+}
+
 void validateRange(const io::SceneSpec& scene, const FrameRange& range) {
   if (range.first < scene.frameStart || range.last > scene.frameEnd)
     throw InputError(
@@ -180,6 +199,20 @@ void writeTextAtomically(const std::string& path, const std::string& text) {
 
 }  // namespace
 
+const char* tearKindName(tear::CandidateKind kind) {
+  switch (kind) {
+    case tear::CandidateKind::Tip:
+      return "tip";
+    case tear::CandidateKind::Junction:
+      return "junction";
+    case tear::CandidateKind::HandleBorder:
+      return "handle_border";
+    case tear::CandidateKind::InwardCorner:
+      return "inward_corner";
+  }
+  return "?";
+}
+
 FrameRange parseFrameRange(const std::string& text) {
   // "A-B" or "A", A and B integers (A may be negative: "-5--2" is -5 to -2).
   const auto bad = [&] { return InputError("--frames", "expected A-B or A, got '" + text + "'"); };
@@ -200,9 +233,11 @@ FrameRange parseFrameRange(const std::string& text) {
 
 mesh::SheetMesh buildSheet(const io::SceneSpec& scene, const io::AnimationScene* animation) {
   const auto& s = scene.sheet;
-  if (s.kind == io::SheetSpec::Kind::Rectangle) {
+  if (s.kind == io::SheetSpec::Kind::Rectangle || s.kind == io::SheetSpec::Kind::Outline) {
     const double maxEdge = s.maxEdge > 0.0 ? s.maxEdge : std::min(s.width, s.height) / 16.0;
-    auto sheet = mesh::makeRectangleSheet(s.width, s.height, maxEdge);
+    auto sheet = s.kind == io::SheetSpec::Kind::Rectangle
+                     ? mesh::makeRectangleSheet(s.width, s.height, maxEdge)
+                     : mesh::makePolygonSheet(s.outline, maxEdge);
     mesh::placePattern(sheet, s.origin, s.uAxis.normalized(), s.vAxis.normalized());
     return sheet;
   }
@@ -335,6 +370,12 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
                                                                        : "auto";
   if (elastic) elastic->setContacts(contact);
   if (hybrid) hybrid->setContacts(contact);
+  // Tearing (issue 6): runs only when the scene enables it.
+  std::optional<tear::Tearing> tearing;
+  if (scene.tear.enabled) {
+    tearing.emplace(sheet, tearingParamsOf(scene.tear), seed);
+    report.tearingOn = true;
+  }
 
   cache::CacheHeader header;
   header.fps = scene.fps;
@@ -369,6 +410,12 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   const double dt = 1.0 / (scene.fps * scene.substeps);
   const sim::PinFunction pins = [&rig](double t, std::vector<sim::Pin>& out) { rig.pins(t, out); };
 
+  // The contacts of a frame whose elastic model was rebuilt by a tear
+  // (vertex indices survive a cut).
+  std::optional<std::vector<sim::ContactSample>> carriedContacts;
+  // The baked tear textures (TEAR block) of the current mesh, re-baked when a
+  // tear advances (thesis 3.3.4).
+  std::optional<cache::ExtensionBlock> tearAtlasBlock;
   auto emit = [&](int frame) {
     const double t = frameTime(scene, frame);
     record.frame = frame;
@@ -396,6 +443,16 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
       report.singularVertices = hybrid->singularVertexCount();
       report.interiorSingularVertices = hybrid->interiorSingularVertexCount();
     } else {
+      if (tearing) {  // the topology changes where the sheet tears
+        // A crumpling-model sheet that tore keeps its singular vertices
+        // (same indices); its rulings and junctions are no longer tracked.
+        record.rulings.clear();
+        record.junctionVertices.clear();
+        record.triangles = sheet.triangles;
+        record.regionOfTriangle = sheet.regionOfTriangle;
+        record.pattern = sheet.pattern;
+        report.maxTriangles = std::max(report.maxTriangles, sheet.triangleCount());
+      }
       record.positions = elastic->positions();
     }
     record.handleVertices.clear();
@@ -410,9 +467,13 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     record.extensions.clear();
     if (auto motions = propMotionBlock(scene, animation.get(), t))
       record.extensions.push_back(std::move(*motions));
+    if (tearAtlasBlock) record.extensions.push_back(*tearAtlasBlock);
+    record.tearCount = tearing ? static_cast<std::uint32_t>(tearing->startKinds().size()) : 0;
     if (contactsOn) {
       // What the sheet touches at the end of the frame (the sound module's input).
-      const auto& samples = hybrid ? hybrid->contacts() : elastic->contacts();
+      const auto& samples = hybrid            ? hybrid->contacts()
+                            : carriedContacts ? *carriedContacts
+                                              : elastic->contacts();
       std::vector<cache::ContactRecord> touching;
       touching.reserve(samples.size());
       for (const auto& c : samples)
@@ -451,6 +512,100 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     progress.update(frame - scene.frameStart + 1);
   };
 
+  // The tearing stage of a frame (thesis 3.3, Fig. 3.14), after its elastic
+  // substeps: candidates tested with the step's membrane forces, the mesh
+  // cut where E_r >= E_f, and the elastic model rebuilt on the cut mesh with
+  // the velocities carried over.
+  const auto tearFrame = [&](int frame) {
+    const auto start = Clock::now();
+    // The sheet the frame ended with: the elastic model's mesh, or the
+    // crumpling model's S_P (whose junction vertices are candidates too).
+    const sim::ElasticSheet& model = hybrid ? hybrid->elastic() : *elastic;
+    std::vector<int> junctions;
+    if (hybrid) {
+      sheet = hybrid->physical().mesh;
+      junctions = paper::junctionVertices(hybrid->geometric());  // S_G vertices are S_P's first
+    }
+    sheet.positions = model.positions();
+    std::vector<char> held(sheet.vertexCount(), 0);
+    std::vector<sim::Pin> holding;
+    rig.pins(frameTime(scene, frame), holding);
+    for (const auto& pin : holding) held[static_cast<std::size_t>(pin.vertex)] = 1;
+    // Forces in units of k_s h (tear::TearParams::resistance): E_r is strain-like.
+    const double unit = materialOf(scene.paper).stretchStiffness() * tearing->edgeLength();
+    const tear::VertexForces forces = [&](int v) {
+      std::vector<tear::TriangleForce> out;
+      for (const auto& f : model.membraneForcesOn(v)) out.push_back({f.triangle, f.force / unit});
+      return out;
+    };
+    tear::TearFrameResult r;
+    try {
+      r = tearing->step(sheet, junctions, held, forces);
+    } catch (const std::exception& e) {
+      throw NumericalError("tear", frame, e.what());
+    }
+    // Developer trace (docs/TEARING.md): every candidate's Griffith test.
+    if (const char* trace = std::getenv("CRUMPLE_DEBUG_TEAR"); trace != nullptr && trace[0] == '1')
+      for (const auto& t : r.tests) {
+        const Vec2& at = sheet.pattern[static_cast<std::size_t>(t.candidate.vertex)];
+        std::fprintf(stderr,
+                     "tear: frame %d vertex %d (%s) at [%.5f, %.5f]: E_r %.4g, E_f %.4g, theta "
+                     "%.3f, direction [%.3f, %.3f]%s\n",
+                     frame, t.candidate.vertex, tearKindName(t.candidate.kind), at.x(), at.y(),
+                     t.propagation.energyRelease, t.fractureEnergy, t.propagation.angle,
+                     t.propagation.direction.x(), t.propagation.direction.y(),
+                     t.tears ? " tears" : "");
+      }
+    if (r.changed()) {
+      for (const auto& e : r.events) {
+        report.tearAdvances.push_back({frame, e});
+        if (report.firstTearFrame < 0) report.firstTearFrame = frame;
+      }
+      // The elastic model on the cut mesh: velocities carried over the cut,
+      // each uncut hinge's rest angle and stiffness factor kept (the
+      // crumpling model's fiber damage, thesis 2.3.3).
+      const std::vector<Vec3> velocities =
+          tear::blendValues(model.velocities(), r.blends, r.relocated);
+      std::map<std::pair<int, int>, std::pair<double, double>> hingeState;
+      for (std::size_t h = 0; h < model.hinges().size(); ++h)
+        hingeState[{model.hinges()[h].v[0], model.hinges()[h].v[1]}] = {
+            model.hingeRestAngle(h), model.hingeStiffnessFactor(h)};
+      carriedContacts = hybrid ? hybrid->contacts() : model.contacts();
+      sim::ElasticSheet next(sheet, materialOf(scene.paper), params);
+      next.setVelocities(velocities);
+      next.setContacts(contact);
+      for (std::size_t h = 0; h < next.hinges().size(); ++h) {
+        const auto it = hingeState.find({next.hinges()[h].v[0], next.hinges()[h].v[1]});
+        if (it == hingeState.end()) continue;
+        next.setHingeRestAngle(h, it->second.first);
+        next.setHingeStiffnessFactor(h, it->second.second);
+      }
+      elastic.emplace(std::move(next));
+      if (hybrid) {
+        // The geometric layer cannot be cut (docs/TEARING.md): from its first
+        // tear on, the sheet goes on as the elastic model on its S_P.
+        hybrid.reset();
+        report.tearHandoverFrame = frame;
+        report.notes.push_back("the sheet tore at frame " + std::to_string(frame) +
+                               ": from there on it is simulated by the elastic model on the "
+                               "crumpling model's last S_P (the geometric layer is not cut)");
+      }
+      const auto bakeStart = Clock::now();
+      tear::TearAtlasParams atlas;
+      atlas.texelSize = tearing->fibers().texelSize();
+      try {
+        tearAtlasBlock =
+            cache::encodeTearAtlas(tear::bakeTearAtlas(sheet, tearing->segments(), atlas));
+      } catch (const std::exception& e) {
+        throw NumericalError("tear atlas", frame, e.what());
+      }
+      report.tearBakeMs += msSince(bakeStart);
+    }
+    report.tearMs += msSince(start);
+    report.stages["tear"].totalMs += msSince(start);  // the atlas's baking included
+    report.stages["tear"].frames += 1;
+  };
+
   try {
     emit(scene.frameStart);
     for (int frame = scene.frameStart + 1; frame <= range.last; ++frame) {
@@ -479,6 +634,8 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
           report.stages[name].totalMs += ms;
           report.stages[name].frames += 1;
         }
+        carriedContacts.reset();
+        if (tearing) tearFrame(frame);
         emit(frame);
         continue;
       }
@@ -500,6 +657,8 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
       }
       report.stages["elastic"].totalMs += msSince(start);
       report.stages["elastic"].frames += 1;
+      carriedContacts.reset();
+      if (tearing) tearFrame(frame);
       emit(frame);
     }
   } catch (const NumericalError& e) {
@@ -513,6 +672,10 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   }
   progress.finish();
   writer.close();
+  if (tearing) {
+    report.tearSegments = tearing->segments();
+    report.tearStartKinds = tearing->startKinds();
+  }
   if (renderer && report.framesRendered > 0)
     finishFrames(report.framesDir, FrameRange{std::max(range.first, scene.frameStart), range.last},
                  scene.fps, report.outDir, options.rendering, report.contactSheetPath,
@@ -620,6 +783,20 @@ std::string summaryText(const ShotReport& r) {
                   r.maxContactDepthFrame);
     out += line;
   }
+  if (r.tearingOn) {
+    const double frames = std::max(1, r.framesSimulated - 1);
+    if (r.tearStartKinds.empty()) {
+      std::snprintf(line, sizeof line, "  tearing  %.2f ms/frame: nothing tore\n",
+                    r.tearMs / frames);
+    } else {
+      std::snprintf(line, sizeof line,
+                    "  tearing  %.2f ms/frame: %zu tear(s), the first at frame %d, %zu tip "
+                    "advances\n",
+                    r.tearMs / frames, r.tearStartKinds.size(), r.firstTearFrame,
+                    r.tearAdvances.size());
+    }
+    out += line;
+  }
   out += "  cache:   " + r.cachePath + "\n";
   if (!r.framesDir.empty()) out += "  frames:  " + r.framesDir + "/\n";
   if (!r.contactSheetPath.empty()) out += "  contact sheet: " + r.contactSheetPath + "\n";
@@ -656,7 +833,7 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
   j.key("crumpling_model").value(r.hybrid);
   j.key("contacts").value(!scene.colliders.empty());
   j.key("self_contact").value(r.selfContactSteps > 0);
-  j.key("tearing").value(false);
+  j.key("tearing").value(r.tearingOn);
   j.key("sound").value(false);
   j.key("render_osmesa").value(r.framesRendered > 0 && r.renderBackend == "osmesa");
   j.key("render_embree").value(r.framesRendered > 0 && r.renderBackend == "embree");
@@ -680,6 +857,32 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
         .value(static_cast<double>(r.contactSamples) / std::max(1, r.framesSimulated));
     j.key("max_depth_thicknesses").value(r.maxContactDepth);
     j.key("max_depth_frame").value(r.maxContactDepthFrame);
+    j.endObject();
+  }
+  if (r.tearingOn) {
+    // Issue 6: the tears, where each started and how far it ran.
+    const double frames = std::max(1, r.framesSimulated - 1);
+    j.key("tearing").beginObject();
+    j.key("ms_per_frame").value(r.tearMs / frames);
+    j.key("bake_ms_per_frame").value(r.tearBakeMs / frames);
+    j.key("first_tear_frame").value(r.firstTearFrame);
+    j.key("tip_advances").value(static_cast<long long>(r.tearAdvances.size()));
+    j.key("handover_frame").value(r.tearHandoverFrame);
+    j.key("tears").beginArray();
+    for (std::size_t t = 0; t < r.tearStartKinds.size(); ++t) {
+      j.beginObject();
+      j.key("started_at").value(tearKindName(r.tearStartKinds[t]));
+      double length = 0.0, detail = 0.0;
+      for (const auto& seg : r.tearSegments)
+        if (seg.tear == static_cast<int>(t)) {
+          length += tear::pathLength(seg.cut);
+          detail += tear::pathLength(seg.detail);
+        }
+      j.key("cut_length_m").value(length);
+      j.key("detail_length_m").value(detail);
+      j.endObject();
+    }
+    j.endArray();
     j.endObject();
   }
   j.key("newton_iterations").value(static_cast<long long>(r.newtonIterations));

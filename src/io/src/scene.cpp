@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <numbers>
 #include <optional>
 #include <set>
 #include <utility>
@@ -61,7 +62,7 @@ class SceneParser {
   SceneSpec parse() {
     const TableReader root(root_, "", file_);
     root.allowOnly({"scene", "sheet", "paper", "handles", "camera", "lights", "environment",
-                    "ground", "props", "colliders", "friction", "contact", "output", "sim",
+                    "ground", "props", "colliders", "friction", "contact", "tear", "output", "sim",
                     "model"});
     // [scene] first: its `units` scales every length that follows.
     parseScene(root.subTable("scene"));
@@ -80,6 +81,7 @@ class SceneParser {
     parseFriction(root.subTable("friction"));
     parseColliders(root);
     parseContact(root.subTable("contact"));
+    parseTear(root.subTable("tear"));
     parseOutput(root.subTable("output"));
     parseSim(root.subTable("sim"));
     parseModel(root.subTable("model"));
@@ -154,10 +156,25 @@ class SceneParser {
 
   void parseSheet(const toml::table& table) {
     const TableReader r(table, "sheet", file_);
-    r.allowOnly({"width", "height", "pattern_mesh", "max_edge", "origin", "u_axis", "v_axis"});
+    r.allowOnly(
+        {"width", "height", "pattern_mesh", "outline", "max_edge", "origin", "u_axis", "v_axis"});
     SheetSpec& s = spec_.sheet;
     const bool rect = r.has("width") || r.has("height");
-    if (r.has("pattern_mesh")) {
+    if (r.has("outline") && (rect || r.has("pattern_mesh")))
+      r.fail("outline", "give one of width/height, pattern_mesh or outline");
+    if (r.has("outline")) {
+      s.kind = SheetSpec::Kind::Outline;
+      s.outline = parseOutline(r);
+      Vec2 hi = s.outline.front();
+      for (const Vec2& q : s.outline) hi = hi.cwiseMax(q);
+      s.width = hi.x();
+      s.height = hi.y();
+      if (auto o = r.vec3("origin")) s.origin = *o * mpu();
+      if (auto u = r.vec3("u_axis")) s.uAxis = r.requireDirection("u_axis", *u);
+      if (auto v = r.vec3("v_axis")) s.vAxis = r.requireDirection("v_axis", *v);
+      if (std::abs(s.uAxis.dot(s.vAxis)) > 1e-6)
+        r.fail(r.has("v_axis") ? "v_axis" : "u_axis", "u_axis and v_axis must be perpendicular");
+    } else if (r.has("pattern_mesh")) {
       if (rect) {
         r.fail(r.has("width") ? "width" : "height",
                "give either width/height or pattern_mesh, not both");
@@ -195,6 +212,59 @@ class SceneParser {
         r.fail("max_edge", "is larger than the sheet itself");
       }
     }
+  }
+
+  // [sheet] outline = [[u, v], ...]: at least 3 points, none negative, a
+  // simple polygon (no two edges cross or touch but neighbours at their
+  // shared point); returned counter-clockwise, scaled to m.
+  std::vector<Vec2> parseOutline(const TableReader& r) const {
+    const toml::array* arr = r.find("outline")->as_array();
+    const std::string expected = "expected an array of [u, v] points";
+    if (!arr) r.fail("outline", expected);
+    std::vector<Vec2> pts;
+    for (const toml::node& n : *arr) {
+      const toml::array* p = n.as_array();
+      if (!p || p->size() != 2) r.fail("outline", expected);
+      Vec2 q;
+      for (int k = 0; k < 2; ++k) {
+        const toml::node& c = *p->get(static_cast<std::size_t>(k));
+        if (auto i = c.as_integer()) {
+          q[k] = static_cast<double>(i->get());
+        } else if (auto d = c.as_floating_point()) {
+          q[k] = d->get();
+        } else {
+          r.fail("outline", expected);
+        }
+      }
+      if (!std::isfinite(q.x()) || !std::isfinite(q.y()) || q.minCoeff() < 0.0)
+        r.fail("outline", "point " + std::to_string(pts.size()) +
+                              " must be finite and not negative (the pattern starts at [0, 0])");
+      pts.push_back(q * mpu());
+    }
+    if (pts.size() < 3) r.fail("outline", "needs at least 3 points");
+    double area = 0.0;
+    const std::size_t n = pts.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec2& a = pts[i];
+      const Vec2& b = pts[(i + 1) % n];
+      area += a.x() * b.y() - a.y() * b.x();
+    }
+    if (std::abs(area) < 1e-12) r.fail("outline", "encloses no area");
+    if (area < 0.0) std::reverse(pts.begin(), pts.end());
+    const auto cross = [](const Vec2& u, const Vec2& v) { return u.x() * v.y() - u.y() * v.x(); };
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t j = i + 1; j < n; ++j) {
+        const bool neighbours = j == i + 1 || (i == 0 && j == n - 1);
+        const Vec2 &a = pts[i], &b = pts[(i + 1) % n], &c = pts[j], &d = pts[(j + 1) % n];
+        const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
+        const double d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
+        const bool crosses = ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0)) && d1 != 0.0 &&
+                             d2 != 0.0 && d3 != 0.0 && d4 != 0.0;
+        if (crosses || (!neighbours && (a == c || a == d || b == c || b == d)))
+          r.fail("outline", "edges " + std::to_string(i) + " and " + std::to_string(j) +
+                                " cross or touch: the outline must be a simple polygon");
+      }
+    return pts;
   }
 
   std::vector<std::string> availablePresets() const {
@@ -305,7 +375,7 @@ class SceneParser {
       if (auto p = r.vec2("pattern")) {
         const Vec2 q = *p * mpu();
         const SheetSpec& s = spec_.sheet;
-        if (s.kind == SheetSpec::Kind::Rectangle) {
+        if (s.kind != SheetSpec::Kind::PatternMesh) {  // inside the (bounding) rectangle
           const double tol = 1e-9 * std::max(s.width, s.height);
           if (q.x() < -tol || q.x() > s.width + tol || q.y() < -tol || q.y() > s.height + tol) {
             r.fail("pattern", "point [" + formatNumber((*p).x()) + ", " + formatNumber((*p).y()) +
@@ -643,6 +713,55 @@ class SceneParser {
       spec_.contact.self = ContactSpec::Self::Auto;
     } else {
       r.fail("self", expected + ", got " + detail::typeName(*self));
+    }
+  }
+
+  // [tear]: the table's presence enables tearing (enabled = false keeps it off).
+  void parseTear(const toml::table* table) {
+    if (!table) return;
+    const TableReader r(*table, "tear", file_);
+    r.allowOnly({"enabled", "resistance", "tip_damage", "speed_m", "texel_mm", "fiber_size_mm",
+                 "fiber_octaves", "fiber_anisotropy", "fiber_direction", "detail_blend",
+                 "stress_width_mm", "inward_angle_deg", "max_new_per_frame"});
+    TearSpec& t = spec_.tear;
+    t.enabled = r.boolean("enabled").value_or(true);
+    if (auto v = r.number("resistance")) t.resistance = r.requireNonNegative("resistance", *v);
+    if (auto v = r.number("tip_damage")) {
+      if (!(*v >= 0.0 && *v <= 1.0)) r.fail("tip_damage", "must be in [0, 1]");
+      t.tipDamage = *v;
+    }
+    if (auto v = r.number("speed_m")) t.speed = r.requirePositive("speed_m", *v);
+    if (auto v = r.number("texel_mm")) {
+      t.texel = r.requirePositive("texel_mm", *v) * 1e-3;
+      if (t.texel < 2e-5) r.fail("texel_mm", "must be at least 0.02 mm");
+    }
+    if (auto v = r.number("fiber_size_mm"))
+      t.fiberSize = r.requirePositive("fiber_size_mm", *v) * 1e-3;
+    if (auto v = r.integer("fiber_octaves")) {
+      if (*v < 1 || *v > 12) r.fail("fiber_octaves", "must be in [1, 12]");
+      t.fiberOctaves = static_cast<int>(*v);
+    }
+    if (auto v = r.number("fiber_anisotropy")) {
+      if (!(*v >= 1.0)) r.fail("fiber_anisotropy", "must be >= 1 (1 = isotropic)");
+      t.fiberAnisotropy = *v;
+    }
+    if (auto v = r.vec2("fiber_direction")) {
+      if (!(v->norm() > 0.0)) r.fail("fiber_direction", "must not be zero");
+      t.fiberDirection = v->normalized();
+    }
+    if (auto v = r.number("detail_blend")) {
+      if (!(*v >= 0.0 && *v <= 1.0)) r.fail("detail_blend", "must be in [0, 1]");
+      t.detailBlend = *v;
+    }
+    if (auto v = r.number("stress_width_mm"))
+      t.stressWidth = r.requirePositive("stress_width_mm", *v) * 1e-3;
+    if (auto v = r.number("inward_angle_deg")) {
+      if (!(*v >= 0.0 && *v < 180.0)) r.fail("inward_angle_deg", "must be in [0, 180)");
+      t.minInwardAngle = *v * std::numbers::pi / 180.0;
+    }
+    if (auto v = r.integer("max_new_per_frame")) {
+      if (*v < 0 || *v > 100) r.fail("max_new_per_frame", "must be in [0, 100]");
+      t.maxNewPerFrame = static_cast<int>(*v);
     }
   }
 

@@ -261,6 +261,7 @@ void HybridSheet::setContacts(sim::ContactOptions options) {
 
 const std::vector<sim::ContactSample>& HybridSheet::contacts() const { return impl_->contacts; }
 
+const sim::ElasticSheet& HybridSheet::elastic() const { return *impl_->elastic; }
 const GeometricMesh& HybridSheet::geometric() const { return impl_->sg; }
 const PhysicalMesh& HybridSheet::physical() const { return impl_->sp; }
 const CrumpleParams& HybridSheet::params() const { return impl_->params; }

@@ -111,29 +111,37 @@ struct MeshData {
   V3 color;                     // ground and props
 };
 
-// The sheet's shading data per triangle.
+// The sheet's shading data per triangle (a mesh triangle, or a piece of a
+// tear patch drawn instead of one).
 struct SheetTri {
-  std::array<V3, 3> normals;  // shading normals (front side)
-  std::array<float, 6> uv;    // texture coordinates of the three corners
+  std::array<V3, 3> normals;      // shading normals (front side)
+  std::array<float, 6> uv;        // texture coordinates of the three corners
+  std::array<float, 6> maskUv{};  // tear patches: atlas positions of the corners (texels)
+  bool masked = false;            // a tear patch's piece: its mask cuts it too
 };
 
 // What the alpha-cut filters and the paper shading read.
 struct SheetLook {
   const ImageRGBA8* texture = nullptr;
+  const mesh::TearAtlas* tears = nullptr;
   std::vector<SheetTri> tris;
   V3 front, back;
   float transmittance = 0.0f;
 };
 
-// Texture coordinates at barycentrics (u, v) of a sheet triangle.
-inline Vec2 sheetUv(const SheetTri& t, float u, float v) {
+// Coordinates at barycentrics (u, v) of a triangle's three corners.
+inline Vec2 interpolate(const std::array<float, 6>& c, float u, float v) {
   const float w = 1.0f - u - v;
-  return {static_cast<double>(w * t.uv[0] + u * t.uv[2] + v * t.uv[4]),
-          static_cast<double>(w * t.uv[1] + u * t.uv[3] + v * t.uv[5])};
+  return {static_cast<double>(w * c[0] + u * c[2] + v * c[4]),
+          static_cast<double>(w * c[1] + u * c[3] + v * c[5])};
 }
 
+// Texture coordinates at barycentrics (u, v) of a sheet triangle.
+inline Vec2 sheetUv(const SheetTri& t, float u, float v) { return interpolate(t.uv, u, v); }
+
 // Embree intersect/occluded filter: rejects sheet hits where the texture's
-// bilinear alpha is below 0.5 (cut-outs), for every kind of ray.
+// bilinear alpha is below 0.5 (cut-outs) or, on a tear patch, its mask is
+// (view.hpp), for every kind of ray.
 void alphaCutFilter(const RTCFilterFunctionNArguments* args) {
   const auto* look = static_cast<const SheetLook*>(args->geometryUserPtr);
   for (unsigned i = 0; i < args->N; ++i) {
@@ -141,7 +149,9 @@ void alphaCutFilter(const RTCFilterFunctionNArguments* args) {
     const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
     const float u = RTCHitN_u(args->hit, args->N, i);
     const float v = RTCHitN_v(args->hit, args->N, i);
-    if (sampleTexture(*look->texture, sheetUv(look->tris[prim], u, v)).w() < 0.5)
+    const SheetTri& t = look->tris[prim];
+    if (sampleTexture(*look->texture, sheetUv(t, u, v)).w() < 0.5 ||
+        (t.masked && sampleTearMask(*look->tears, interpolate(t.maskUv, u, v)) < 0.5))
       args->valid[i] = 0;
   }
 }
@@ -721,6 +731,8 @@ ImageRGBAF EmbreeRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
   f.sheet.front = toV3(scene.paper.frontColor);
   f.sheet.back = toV3(scene.paper.backColor);
   f.sheet.transmittance = static_cast<float>(scene.paper.transmittance);
+  f.sheet.tears = &scene.tears;
+  const bool torn = !scene.tears.empty();
   if (!sheet.triangles.empty()) {
     MeshData m;
     m.kind = GeomKind::Sheet;
@@ -729,23 +741,53 @@ ImageRGBAF EmbreeRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
     const auto normals = shadingNormals(sheet.positions, sheet.triangles, scene.paper.creaseAngle,
                                         scene.sharpVertices);
     const Vec2& ts = scene.paper.textureSize;
-    f.sheet.tris.resize(sheet.triangles.size());
-    m.triangles.resize(sheet.triangles.size());
-    m.faceNormals.resize(sheet.triangles.size());
+    // The triangles a tear patch replaces.
+    std::vector<char> replaced(sheet.triangles.size(), 0);
+    for (const mesh::TearPatch& p : scene.tears.patches)
+      replaced[static_cast<std::size_t>(p.triangle)] = 1;
+    f.sheet.tris.reserve(sheet.triangles.size());
+    m.triangles.reserve(sheet.triangles.size());
+    m.faceNormals.reserve(sheet.triangles.size());
     for (std::size_t t = 0; t < sheet.triangles.size(); ++t) {
+      if (replaced[t]) continue;
       const auto& tri = sheet.triangles[t];
-      SheetTri& st = f.sheet.tris[t];
+      SheetTri& st = f.sheet.tris.emplace_back();
+      auto& indices = m.triangles.emplace_back();
       for (std::size_t k = 0; k < 3; ++k) {
         const auto vi = static_cast<std::size_t>(tri[k]);
-        m.triangles[t][k] = static_cast<std::uint32_t>(vi);
+        indices[k] = static_cast<std::uint32_t>(vi);
         st.normals[k] = toV3(normals[t][k]);
         const Vec2 uv = patternToUv(sheet.pattern[vi], ts);
         st.uv[2 * k] = static_cast<float>(uv.x());
         st.uv[2 * k + 1] = static_cast<float>(uv.y());
       }
-      m.faceNormals[t] = faceNormal(sheet.positions[static_cast<std::size_t>(tri[0])],
-                                    sheet.positions[static_cast<std::size_t>(tri[1])],
-                                    sheet.positions[static_cast<std::size_t>(tri[2])]);
+      m.faceNormals.push_back(faceNormal(sheet.positions[static_cast<std::size_t>(tri[0])],
+                                         sheet.positions[static_cast<std::size_t>(tri[1])],
+                                         sheet.positions[static_cast<std::size_t>(tri[2])]));
+    }
+    // The tear patches: the triangle and its support quads, each corner its
+    // own vertex, cut by the patch's mask (thesis 3.3.4, Fig. 3.25).
+    for (const mesh::TearPatch& patch : scene.tears.patches) {
+      const auto t = static_cast<std::size_t>(patch.triangle);
+      for (const mesh::TearPatchTriangle& piece : mesh::tearPatchTriangles(patch, sheet)) {
+        SheetTri& st = f.sheet.tris.emplace_back();
+        st.masked = true;
+        auto& indices = m.triangles.emplace_back();
+        for (std::size_t k = 0; k < 3; ++k) {
+          const mesh::TearPatchVertex& pv = piece[k];
+          indices[k] = static_cast<std::uint32_t>(m.vertices.size());
+          m.vertices.push_back(toV3(pv.position - origin));
+          st.normals[k] = toV3(normals[t][static_cast<std::size_t>(pv.corner)]);
+          const Vec2 uv = patternToUv(pv.pattern, ts);
+          st.uv[2 * k] = static_cast<float>(uv.x());
+          st.uv[2 * k + 1] = static_cast<float>(uv.y());
+          const Vec2 a = mesh::atlasPosition(scene.tears, patch, pv.pattern);
+          st.maskUv[2 * k] = static_cast<float>(a.x());
+          st.maskUv[2 * k + 1] = static_cast<float>(a.y());
+        }
+        m.faceNormals.push_back(
+            faceNormal(piece[0].position, piece[1].position, piece[2].position));
+      }
     }
     f.meshes.push_back(std::move(m));
   }
@@ -811,7 +853,7 @@ ImageRGBAF EmbreeRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
   rtcSetSceneBuildQuality(rtcScene.get(),
                           triangles <= 200000 ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
   for (MeshData& m : f.meshes)
-    attach(rtcScene.get(), m, m.kind == GeomKind::Sheet && cutOuts ? &f.sheet : nullptr);
+    attach(rtcScene.get(), m, m.kind == GeomKind::Sheet && (cutOuts || torn) ? &f.sheet : nullptr);
   rtcCommitScene(rtcScene.get());
   check("rtcCommitScene");
 

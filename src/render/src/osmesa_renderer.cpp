@@ -60,6 +60,10 @@ const char* const kMainVertex = R"(
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
+#ifdef TEAR_MASK
+layout(location = 3) in vec2 a_maskUv;
+out vec2 v_maskUv;
+#endif
 uniform mat4 u_viewProj;
 out vec3 v_pos;
 out vec3 v_normal;
@@ -68,6 +72,9 @@ void main() {
   v_pos = a_pos;
   v_normal = a_normal;
   v_uv = a_uv;
+#ifdef TEAR_MASK
+  v_maskUv = a_maskUv;
+#endif
   gl_Position = u_viewProj * vec4(a_pos, 1.0);
 }
 )";
@@ -78,8 +85,9 @@ void main() {
 // triangle from a buffer texture indexed by gl_PrimitiveID, the structure
 // overlay's colours), ALPHA_CUT (the texture's alpha < 0.5 cuts the paper),
 // TRANSMIT (the paper transmits u_transmittance of the light from its other
-// side), ALBEDO (the albedo pass: unlit). llvmpipe executes both sides of a
-// branch under a mask, so everything not needed is compiled out.
+// side), ALBEDO (the albedo pass: unlit), and TEAR_MASK when defined (a tear
+// patch: its mask < 0.5 cuts the paper too). llvmpipe executes both sides of
+// a branch under a mask, so everything not needed is compiled out.
 const char* const kMainFragment = R"(
 in vec3 v_pos;
 in vec3 v_normal;
@@ -88,6 +96,10 @@ uniform sampler2D u_tex;
 uniform sampler2DShadow u_shadowMap;
 #if TRI_COLORS
 uniform samplerBuffer u_triColors;
+#endif
+#ifdef TEAR_MASK
+in vec2 v_maskUv;
+uniform sampler2D u_mask;
 #endif
 uniform vec3 u_frontColor;
 uniform vec3 u_backColor;
@@ -138,6 +150,9 @@ float keyVisibility(vec3 p, vec3 ng, vec3 L) {
 void main() {
 #if ALPHA_CUT && !IS_GROUND
   if (textureLod(u_tex, v_uv, 0.0).a < 0.5) discard;
+#endif
+#ifdef TEAR_MASK
+  if (textureLod(u_mask, v_maskUv, 0.0).r < 0.5) discard;
 #endif
   vec3 ng = cross(dFdx(v_pos), dFdy(v_pos));
   float ngLen = length(ng);
@@ -212,21 +227,36 @@ void main() { o_color = v_color; }
 const char* const kShadowVertex = R"(
 layout(location = 0) in vec3 a_pos;
 layout(location = 2) in vec2 a_uv;
+#ifdef TEAR_MASK
+layout(location = 3) in vec2 a_maskUv;
+out vec2 v_maskUv;
+#endif
 uniform mat4 u_lightViewProj;
 out vec2 v_uv;
 void main() {
   v_uv = a_uv;
+#ifdef TEAR_MASK
+  v_maskUv = a_maskUv;
+#endif
   gl_Position = u_lightViewProj * vec4(a_pos, 1.0);
 }
 )";
 
-// ALPHA_CUT: light passes where the paper is cut.
+// ALPHA_CUT: light passes where the paper is cut; TEAR_MASK (defined): and
+// where a tear patch's mask cuts it.
 const char* const kShadowFragment = R"(
 in vec2 v_uv;
 uniform sampler2D u_tex;
+#ifdef TEAR_MASK
+in vec2 v_maskUv;
+uniform sampler2D u_mask;
+#endif
 void main() {
 #if ALPHA_CUT
   if (textureLod(u_tex, v_uv, 0.0).a < 0.5) discard;
+#endif
+#ifdef TEAR_MASK
+  if (textureLod(u_mask, v_maskUv, 0.0).r < 0.5) discard;
 #endif
 }
 )";
@@ -373,6 +403,17 @@ struct Vertex {
   float uv[2];
 };
 
+// A corner of a tear patch's triangle: a Vertex and its atlas coordinates.
+struct PatchVertex {
+  float pos[3];
+  float normal[3];
+  float uv[2];
+  float maskUv[2];  // normalised atlas coordinates
+};
+
+// The texture unit of the tear atlas's mask.
+constexpr int kMaskUnit = 3;
+
 }  // namespace
 
 struct OsmesaRenderer::Impl {
@@ -383,15 +424,19 @@ struct OsmesaRenderer::Impl {
   OsmesaContext context;
 
   GLuint shadowProgram = 0;
-  GLuint shadowCutProgram = 0;  // the shadow pass of a paper with cut-outs
+  GLuint shadowCutProgram = 0;      // the shadow pass of a paper with cut-outs
+  GLuint shadowMaskProgram = 0;     // ... of tear patches
+  GLuint shadowMaskCutProgram = 0;  // ... of tear patches of a paper with cut-outs
   GLuint overlayProgram = 0;
   // Main-pass programs by variant (lights, key light, key is point, ground,
-  // triangle colours, alpha cut, transmission, albedo pass).
-  std::map<std::array<int, 8>, GLuint> mainPrograms;
+  // triangle colours, alpha cut, transmission, albedo pass, tear mask).
+  std::map<std::array<int, 9>, GLuint> mainPrograms;
   int shadowSize = kShadowMapSmall;
   GLuint paperVao = 0, paperVbo = 0;
   GLuint groundVao = 0, groundVbo = 0;
   GLuint propVao = 0, propVbo = 0;
+  GLuint patchVao = 0, patchVbo = 0;
+  GLuint maskTex = 0;
   GLuint msFbo = 0, msColor = 0, msDepth = 0;
   GLuint resolveFbo = 0, resolveColor = 0;
   GLuint shadowFbo = 0, shadowTex = 0;
@@ -405,9 +450,10 @@ struct OsmesaRenderer::Impl {
   bool textureHasCut = false;  // some texel's alpha < 0.5: the paper has cut-outs
   ImageRGBA8 uploadedTexture;
 
-  std::vector<Vertex> vertices;      // three per sheet triangle (split shading normals)
-  std::vector<Vertex> propVertices;  // three per prop triangle, all props
-  std::vector<GLint> propFirst;      // first vertex of each prop
+  std::vector<Vertex> vertices;            // three per sheet triangle (split shading normals)
+  std::vector<PatchVertex> patchVertices;  // three per triangle of the tear patches
+  std::vector<Vertex> propVertices;        // three per prop triangle, all props
+  std::vector<GLint> propFirst;            // first vertex of each prop
   std::vector<std::uint8_t> readback;
   std::vector<GLfloat> triColors;
 
@@ -446,14 +492,23 @@ struct OsmesaRenderer::Impl {
     shadowCutProgram = linkProgram("#define ALPHA_CUT 1\n", kShadowVertex, kShadowFragment);
     glUseProgram(shadowCutProgram);
     glUniform1i(glGetUniformLocation(shadowCutProgram, "u_tex"), 0);
+    shadowMaskProgram =
+        linkProgram("#define ALPHA_CUT 0\n#define TEAR_MASK 1\n", kShadowVertex, kShadowFragment);
+    shadowMaskCutProgram =
+        linkProgram("#define ALPHA_CUT 1\n#define TEAR_MASK 1\n", kShadowVertex, kShadowFragment);
+    for (const GLuint p : {shadowMaskProgram, shadowMaskCutProgram}) {
+      glUseProgram(p);
+      glUniform1i(glGetUniformLocation(p, "u_tex"), 0);
+      glUniform1i(glGetUniformLocation(p, "u_mask"), kMaskUnit);
+    }
     overlayProgram = linkProgram("", kOverlayVertex, kOverlayFragment);
   }
 
   GLuint mainProgram(int numLights, int keyLight, bool keyIsPoint, bool ground, bool triColors,
-                     bool alphaCut, bool transmit, bool albedo) {
-    const std::array<int, 8> variant = {numLights,        keyLight,          keyIsPoint ? 1 : 0,
+                     bool alphaCut, bool transmit, bool albedo, bool tearMask = false) {
+    const std::array<int, 9> variant = {numLights,        keyLight,          keyIsPoint ? 1 : 0,
                                         ground ? 1 : 0,   triColors ? 1 : 0, alphaCut ? 1 : 0,
-                                        transmit ? 1 : 0, albedo ? 1 : 0};
+                                        transmit ? 1 : 0, albedo ? 1 : 0,    tearMask ? 1 : 0};
     const auto it = mainPrograms.find(variant);
     if (it != mainPrograms.end()) return it->second;
     const std::string defines =
@@ -462,12 +517,13 @@ struct OsmesaRenderer::Impl {
         "\n#define IS_GROUND " + std::to_string(variant[3]) + "\n#define TRI_COLORS " +
         std::to_string(variant[4]) + "\n#define ALPHA_CUT " + std::to_string(variant[5]) +
         "\n#define TRANSMIT " + std::to_string(variant[6]) + "\n#define ALBEDO " +
-        std::to_string(variant[7]) + "\n";
+        std::to_string(variant[7]) + "\n" + (tearMask ? "#define TEAR_MASK 1\n" : "");
     const GLuint program = linkProgram(defines, kMainVertex, kMainFragment);
     glUseProgram(program);
     glUniform1i(glGetUniformLocation(program, "u_tex"), 0);
     glUniform1i(glGetUniformLocation(program, "u_shadowMap"), 1);
     if (triColors) glUniform1i(glGetUniformLocation(program, "u_triColors"), 2);
+    if (tearMask) glUniform1i(glGetUniformLocation(program, "u_mask"), kMaskUnit);
     mainPrograms.emplace(variant, program);
     return program;
   }
@@ -504,6 +560,26 @@ struct OsmesaRenderer::Impl {
     glBindBuffer(GL_ARRAY_BUFFER, propVbo);
     setupVertexLayout();
 
+    glGenVertexArrays(1, &patchVao);
+    glGenBuffers(1, &patchVbo);
+    glBindVertexArray(patchVao);
+    glBindBuffer(GL_ARRAY_BUFFER, patchVbo);
+    {
+      const auto stride = static_cast<GLsizei>(sizeof(PatchVertex));
+      glEnableVertexAttribArray(0);
+      glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride,
+                            reinterpret_cast<const void*>(offsetof(PatchVertex, pos)));
+      glEnableVertexAttribArray(1);
+      glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride,
+                            reinterpret_cast<const void*>(offsetof(PatchVertex, normal)));
+      glEnableVertexAttribArray(2);
+      glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride,
+                            reinterpret_cast<const void*>(offsetof(PatchVertex, uv)));
+      glEnableVertexAttribArray(3);
+      glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, stride,
+                            reinterpret_cast<const void*>(offsetof(PatchVertex, maskUv)));
+    }
+
     glGenVertexArrays(1, &overlayVao);
     glGenBuffers(1, &overlayVbo);
     glBindVertexArray(overlayVao);
@@ -518,6 +594,7 @@ struct OsmesaRenderer::Impl {
     glBindVertexArray(0);
 
     glGenTextures(1, &paperTex);
+    glGenTextures(1, &maskTex);
     glGenBuffers(1, &triColorBuffer);
     glGenTextures(1, &triColorTex);
   }
@@ -646,6 +723,22 @@ struct OsmesaRenderer::Impl {
       uploadedTexture = tex;
   }
 
+  // The tear atlas's mask as a single-channel texture on kMaskUnit (GL_LINEAR,
+  // clamped, level 0 only: sampleTearMask's lookup).
+  void uploadMask(const mesh::TearAtlas& atlas) {
+    glActiveTexture(GL_TEXTURE0 + kMaskUnit);
+    glBindTexture(GL_TEXTURE_2D, maskTex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, atlas.width, atlas.height, 0, GL_RED, GL_UNSIGNED_BYTE,
+                 atlas.mask.data());
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+    glActiveTexture(GL_TEXTURE0);
+  }
+
   ImageRGBA8 render(const RenderScene& scene, const mesh::SheetMesh& sheet,
                     const StructureOverlay* overlay, RenderPass pass);
 };
@@ -692,28 +785,66 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
   const auto cornerNormals = shadingNormals(sheet.positions, sheet.triangles,
                                             scene.paper.creaseAngle, scene.sharpVertices);
   const std::size_t nt = sheet.triangles.size();
-  vertices.resize(nt * 3);
+  // Tear patches are drawn instead of their triangles (view.hpp), except in
+  // the structure view with triangle colours, which shows the mesh.
+  const bool torn =
+      !scene.tears.empty() && !(overlay != nullptr && !overlay->triangleColors.empty());
+  std::vector<char> replaced(nt, 0);
+  if (torn)
+    for (const mesh::TearPatch& p : scene.tears.patches)
+      replaced[static_cast<std::size_t>(p.triangle)] = 1;
+  vertices.clear();
+  vertices.reserve(nt * 3);
   const Vec2& ts = scene.paper.textureSize;
-  for (std::size_t t = 0; t < nt; ++t)
+  // Fills the attributes a sheet vertex and a patch vertex share.
+  const auto setVertex = [&](auto& v, const Vec3& position, const Vec3& n, const Vec2& pattern) {
+    const Vec3 p = position - origin;
+    // The texture's top row sits at pattern y = textureSize.y: seen from the
+    // front with the pattern's +y up, the image is upright and not mirrored.
+    const Vec2 uv = patternToUv(pattern, ts);
+    for (int c = 0; c < 3; ++c) {
+      v.pos[c] = static_cast<float>(p[c]);
+      v.normal[c] = static_cast<float>(n[c]);
+    }
+    v.uv[0] = static_cast<float>(uv.x());
+    v.uv[1] = static_cast<float>(uv.y());
+  };
+  for (std::size_t t = 0; t < nt; ++t) {
+    if (replaced[t]) continue;
     for (std::size_t k = 0; k < 3; ++k) {
       const auto i = static_cast<std::size_t>(sheet.triangles[t][k]);
-      const Vec3 p = sheet.positions[i] - origin;
-      const Vec3& n = cornerNormals[t][k];
-      // The texture's top row sits at pattern y = textureSize.y: seen from the
-      // front with the pattern's +y up, the image is upright and not mirrored.
-      const Vec2 uv = patternToUv(sheet.pattern[i], ts);
-      Vertex& v = vertices[t * 3 + k];
-      for (int c = 0; c < 3; ++c) {
-        v.pos[c] = static_cast<float>(p[c]);
-        v.normal[c] = static_cast<float>(n[c]);
-      }
-      v.uv[0] = static_cast<float>(uv.x());
-      v.uv[1] = static_cast<float>(uv.y());
+      setVertex(vertices.emplace_back(), sheet.positions[i], cornerNormals[t][k], sheet.pattern[i]);
     }
+  }
   glBindVertexArray(paperVao);
   glBindBuffer(GL_ARRAY_BUFFER, paperVbo);
   glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)),
                vertices.data(), GL_STREAM_DRAW);
+  // The tear patches (thesis 3.3.4, Fig. 3.25): the triangle and its
+  // support quads, cut by the patch's mask.
+  patchVertices.clear();
+  if (torn) {
+    const Vec2 atlasSize(scene.tears.width, scene.tears.height);
+    for (const mesh::TearPatch& patch : scene.tears.patches) {
+      const auto t = static_cast<std::size_t>(patch.triangle);
+      for (const mesh::TearPatchTriangle& piece : mesh::tearPatchTriangles(patch, sheet))
+        for (const mesh::TearPatchVertex& pv : piece) {
+          PatchVertex& v = patchVertices.emplace_back();
+          setVertex(v, pv.position, cornerNormals[t][static_cast<std::size_t>(pv.corner)],
+                    pv.pattern);
+          const Vec2 m =
+              mesh::atlasPosition(scene.tears, patch, pv.pattern).cwiseQuotient(atlasSize);
+          v.maskUv[0] = static_cast<float>(m.x());
+          v.maskUv[1] = static_cast<float>(m.y());
+        }
+    }
+    glBindVertexArray(patchVao);
+    glBindBuffer(GL_ARRAY_BUFFER, patchVbo);
+    glBufferData(GL_ARRAY_BUFFER,
+                 static_cast<GLsizeiptr>(patchVertices.size() * sizeof(PatchVertex)),
+                 patchVertices.data(), GL_STREAM_DRAW);
+    uploadMask(scene.tears);
+  }
 
   // Props: flat-shaded, three vertices per triangle, one draw each.
   propVertices.clear();
@@ -800,6 +931,7 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
                              static_cast<float>(q.z()));
     }
     for (const Vertex& v : propVertices) receivers.emplace_back(v.pos[0], v.pos[1], v.pos[2]);
+    for (const PatchVertex& v : patchVertices) receivers.emplace_back(v.pos[0], v.pos[1], v.pos[2]);
     const std::size_t nv = receivers.size();
     if (scene.ground.enabled)
       for (const Vec3& c : groundCorners) receivers.push_back(c);
@@ -866,6 +998,14 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
                        lightMatrix.data());
     glBindVertexArray(paperVao);
     glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(vertices.size()));
+    if (!patchVertices.empty()) {
+      const GLuint patchShadow = alphaCut ? shadowMaskCutProgram : shadowMaskProgram;
+      glUseProgram(patchShadow);
+      glUniformMatrix4fv(glGetUniformLocation(patchShadow, "u_lightViewProj"), 1, GL_FALSE,
+                         lightMatrix.data());
+      glBindVertexArray(patchVao);
+      glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(patchVertices.size()));
+    }
     if (!propVertices.empty()) {
       glUseProgram(shadowProgram);
       glUniformMatrix4fv(glGetUniformLocation(shadowProgram, "u_lightViewProj"), 1, GL_FALSE,
@@ -933,11 +1073,12 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
   const auto vp = toGl(viewProj);
   const auto lvp = toGl(lightViewProj);
 
-  // What: 0 the ground, 1 a prop (colour), 2 the paper.
+  // What: 0 the ground, 1 a prop (colour), 2 the paper, 3 the tear patches.
   auto draw = [&](int what, const Vec3& color, GLint first, GLsizei count) {
-    const bool plain = what != 2;
-    const GLuint program = mainProgram(numLights, keyLight, keyIsPoint, plain, triColors && !plain,
-                                       alphaCut && !plain, transmit && !plain, albedoPass);
+    const bool plain = what < 2;
+    const GLuint program =
+        mainProgram(numLights, keyLight, keyIsPoint, plain, triColors && !plain, alphaCut && !plain,
+                    transmit && !plain, albedoPass, what == 3);
     glUseProgram(program);
     auto loc = [&](const char* name) { return glGetUniformLocation(program, name); };
     auto set3 = [&](const char* name, const Vec3& v) {
@@ -965,7 +1106,7 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
       glDrawArrays(GL_TRIANGLES, 0, 6);
       glDisable(GL_POLYGON_OFFSET_FILL);
     } else {
-      glBindVertexArray(what == 1 ? propVao : paperVao);
+      glBindVertexArray(what == 1 ? propVao : what == 2 ? paperVao : patchVao);
       glDrawArrays(GL_TRIANGLES, first, count);
     }
   };
@@ -974,6 +1115,7 @@ ImageRGBA8 OsmesaRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
     if (propFirst[i + 1] > propFirst[i])
       draw(1, scene.props[i].color, propFirst[i], propFirst[i + 1] - propFirst[i]);
   if (hasPaper) draw(2, Vec3::Zero(), 0, static_cast<GLsizei>(vertices.size()));
+  if (!patchVertices.empty()) draw(3, Vec3::Zero(), 0, static_cast<GLsizei>(patchVertices.size()));
   glBindVertexArray(0);
   if (overlay != nullptr)
     drawOverlay(detail::buildOverlayGeometry(*overlay, sheet, cam, viewProj, origin));

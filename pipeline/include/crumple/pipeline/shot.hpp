@@ -14,6 +14,7 @@
 #include "crumple/io/scene.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/render/view.hpp"
+#include "crumple/tear/tearing.hpp"
 
 namespace crumple::pipeline {
 
@@ -83,6 +84,22 @@ struct ShotReport {
   // The contacts' share of the simulation step (elastic, geometric, cones,
   // rebuild, isometry and contact stages).
   double contactShareOfStep() const;
+  // Tearing (issue 6): whether it ran, each tip advance (frame, tear, where
+  // from, E_r and E_f) and the tears' paths in the pattern at the end.
+  bool tearingOn = false;
+  struct TearAdvance {
+    int frame = 0;
+    tear::TearEvent event;
+  };
+  std::vector<TearAdvance> tearAdvances;
+  std::vector<tear::TearSegment> tearSegments;
+  std::vector<tear::CandidateKind> tearStartKinds;  // per tear
+  int firstTearFrame = -1;
+  // Crumpling model: the frame from which the torn sheet went on as the
+  // elastic model on its last S_P (-1: it never tore).
+  int tearHandoverFrame = -1;
+  double tearMs = 0.0;      // candidates, Griffith tests, cuts, detail paths, baking (wall time)
+  double tearBakeMs = 0.0;  // of which baking the tear textures
   std::size_t vertices = 0;
   std::size_t triangles = 0;
   double maxHandleError = 0.0;
@@ -104,6 +121,9 @@ struct ShotReport {
   std::vector<std::string> warnings;
   std::string error;  // set when the run stopped early (cache valid up to the last frame)
 };
+
+// "tip", "junction", "handle_border" or "inward_corner" (summary.json).
+const char* tearKindName(tear::CandidateKind kind);
 
 // The simulation mesh of the scene's sheet, placed in the world.
 mesh::SheetMesh buildSheet(const io::SceneSpec& scene, const io::AnimationScene* animation);

@@ -29,10 +29,13 @@ struct PaperPreset {
 };
 
 struct SheetSpec {
-  enum class Kind { Rectangle, PatternMesh };
+  enum class Kind { Rectangle, PatternMesh, Outline };
   Kind kind = Kind::Rectangle;
-  double width = 0.0;        // m (Rectangle)
-  double height = 0.0;       // m (Rectangle)
+  double width = 0.0;   // m (Rectangle; Outline: its bounding box's)
+  double height = 0.0;  // m (Rectangle; Outline: its bounding box's)
+  // Outline: the pattern's polygon (m, counter-clockwise after parsing,
+  // simple, inside [0, width] x [0, height]), meshed to max_edge.
+  std::vector<Vec2> outline;
   std::string patternMesh;   // mesh node name in the animation file (PatternMesh)
   long patternMeshLine = 0;  // scene file line of pattern_mesh (for errors)
   double maxEdge = 0.0;      // m: simulation mesh resolution; 0 = min(width, height) / 16
@@ -152,6 +155,26 @@ struct ContactSpec {
   Self self = Self::Auto;
 };
 
+// [tear]: tearing (issue 6; thesis 3.3). Off unless the table is present
+// (or enabled = true). Lengths have fixed units (their key names say which).
+struct TearSpec {
+  bool enabled = false;
+  // C: E_f = C T_fibers d_p, with E_r in units of the paper's stretch
+  // stiffness times the mesh's edge length (strain-like; tear::TearParams).
+  double resistance = 0.005;
+  double tipDamage = 0.5;   // D in [0, 1]: d_p at a tear's tip
+  double speed = 1.0;       // V (m per unit E_r): the tip advances V E_r per frame
+  double texel = 2.5e-4;    // m: fiber texture and tear-texture resolution
+  double fiberSize = 2e-3;  // m: the fibers' largest noise wavelength
+  int fiberOctaves = 4;
+  double fiberAnisotropy = 1.0;  // >= 1: fibers this much longer along fiber_direction
+  Vec2 fiberDirection = Vec2::UnitX();
+  double detailBlend = 0.5;     // p in thesis eq. (3.2)
+  double stressWidth = 0.5e-3;  // m: G_t's standard deviation
+  double minInwardAngle = 0.1;  // rad: inward corners sharper than pi + this are candidates
+  int maxNewPerFrame = 1;       // tears that may start in one frame
+};
+
 struct GroundSpec {
   bool enabled = false;
   double height = 0.0;  // m, world Y of the plane
@@ -228,6 +251,7 @@ struct SceneSpec {
   // unless the scene overrides them; the scene may add more ("wood", ...).
   std::map<std::string, double> friction;
   ContactSpec contact;  // [contact]
+  TearSpec tear;        // [tear]
   OutputSpec output;
   SimSpec sim;
   ModelSpec model;

@@ -47,6 +47,14 @@ std::vector<MeshEdge> buildEdges(const SheetMesh& mesh);
 // (rounding the cell count up). All four corners are vertices.
 SheetMesh makeRectangleSheet(double width, double height, double maxEdge);
 
+// A simple polygon (counter-clockwise, m) in the pattern, meshed for the
+// simulation: every outline edge split evenly into pieces <= maxEdge,
+// interior points on a hexagonal lattice of spacing maxEdge kept at least
+// maxEdge / 2 from the outline, joined by constrained Delaunay. All outline
+// points are vertices. Throws std::invalid_argument for fewer than 3
+// points, a clockwise outline or a non-positive maxEdge.
+SheetMesh makePolygonSheet(const std::vector<Vec2>& outline, double maxEdge);
+
 // Place a flat pattern in 3D: position = origin + u * uAxis + v * vAxis.
 void placePattern(SheetMesh& mesh, const Vec3& origin, const Vec3& uAxis, const Vec3& vAxis);
 

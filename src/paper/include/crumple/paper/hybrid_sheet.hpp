@@ -87,6 +87,12 @@ class HybridSheet {
   // The time the sheet is at before the first step (s).
   void setTime(double t);
 
+  // The elastic model on the current S_P, at the end of the last step: S_P's
+  // positions and velocities, its hinges' rest angles and stiffness factors
+  // (fiber damage), the membrane forces on a vertex (what a tear tip feels,
+  // thesis 3.3.3), and the state a torn sheet carries over to a plain
+  // sim::ElasticSheet (issue 6).
+  const sim::ElasticSheet& elastic() const;
   const GeometricMesh& geometric() const;  // S_G
   const PhysicalMesh& physical() const;    // S_P (the displayed mesh)
   const CrumpleParams& params() const;

@@ -10,10 +10,7 @@
 
 #include "crumple/core/image.hpp"
 #include "crumple/core/types.hpp"
-
-namespace crumple::mesh {
-struct SheetMesh;
-}  // namespace crumple::mesh
+#include "crumple/mesh/tear_patches.hpp"
 
 namespace crumple::render {
 
@@ -190,6 +187,14 @@ struct RenderScene {
   // This frame's sharp vertices of the sheet (the model's singular vertices):
   // shading normals are not smoothed around them.
   std::vector<int> sharpVertices;
+  // This frame's tear textures (docs/RENDERING.md "Tears"; thesis 3.3.4):
+  // each patch is drawn instead of its triangle, the triangle and its
+  // support quads (mesh::tearPatchTriangles), and the paper is cut where the
+  // patch's mask (sampleTearMask) is below 0.5 as where the texture's alpha
+  // is, for camera, bounce and shadow rays. Empty: the sheet as it is. The
+  // preview's structure view with triangle colours shows the mesh without
+  // them.
+  mesh::TearAtlas tears;
   // The colour of uncovered pixels (their alpha is 0), linear RGB.
   Vec3 background{0.80, 0.82, 0.86};
 };
@@ -215,12 +220,19 @@ std::vector<std::array<Vec3, 3>> shadingNormals(const std::vector<Vec3>& positio
 // decoded before filtering, like GL_SRGB8_ALPHA8) and alpha in [0, 1].
 Vec4 sampleTexture(const ImageRGBA8& texture, const Vec2& uv);
 
+// Bilinear lookup of a tear atlas's mask as OpenGL does it with GL_LINEAR
+// and GL_CLAMP_TO_EDGE at level 0, at an atlas position in texels
+// (mesh::atlasPosition; texel centres at x + 0.5): in [0, 1]; 1 for an
+// empty atlas.
+double sampleTearMask(const mesh::TearAtlas& atlas, const Vec2& position);
+
 // The checks both renderers make before drawing (std::invalid_argument
 // "<who>: <what is wrong>"): a finite camera with 0 < yfov < pi, 0 < znear <
 // zfar and a valid lens; finite lights (directions non-zero, sun angle in [0,
 // pi), area sizes > 0), environment, ground, paper look (texture size
 // consistent, transmittance in [0, 1]) and props; a sheet whose triangles
-// index its finite vertices.
+// index its finite vertices; tear patches valid for the sheet
+// (mesh::validate(atlas, sheet)).
 void validateRenderInput(const RenderScene& scene, const mesh::SheetMesh& sheet, const char* who);
 
 // The paper texture when PaperLook::texture is empty: makeRuledPaperTexture

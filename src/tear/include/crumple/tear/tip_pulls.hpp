@@ -26,14 +26,21 @@ struct TipPulls {
 
 // The direction a tear would take from boundary vertex v with nothing else
 // known: the bisector of the boundary's directions on either side of v,
-// pointing into the sheet (thesis Fig. 3.17). Throws std::invalid_argument
+// pointing into the sheet (thesis Fig. 3.17; at a tear's tip, of its lips).
+// Each direction runs to the first boundary vertex at least the mean length
+// of v's edges away along the boundary. Throws std::invalid_argument
 // when v is not on the boundary.
 Vec2 boundaryBisector(const mesh::SheetMesh& mesh, int vertex);
 
 // The pulls at `vertex` from the forces of its triangles (`forces`, each
 // triangle holding the vertex), with `tearDirection` (pattern, non-zero) as
-// the clustering's first guess. The surface normal at the vertex is the
-// area-weighted normal of those triangles.
+// the clustering's first guess. Only forces that draw the vertex back
+// against the tear direction (in the pattern) are pulls: the forces of the
+// material ahead, which holds the vertex against them, are left out (at a
+// free vertex in equilibrium all the forces sum to zero, and two clusters
+// of all of them would always be opposite: theta = pi, no release). The
+// surface normal at the vertex is the area-weighted normal of the
+// triangles. No pull: both zero, clusters empty.
 TipPulls tipPulls(const mesh::SheetMesh& mesh, int vertex, const std::vector<TriangleForce>& forces,
                   const Vec2& tearDirection);
 

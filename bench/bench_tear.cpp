@@ -1,0 +1,124 @@
+// What tearing costs (issue 6: "benchmark the tearing stage's cost per frame
+// and quote it"):
+//
+//   bench_tear [SAMPLE ...] [--runs 3] [--json FILE]
+//
+// Simulates each sample (default: tear-straight, tear-curved, tear-notch)
+// `runs` times on one thread, without rendering, and prints the medians of
+// the simulation step per frame, the tearing stage per frame (candidates,
+// Griffith tests, cuts, detail paths, the elastic model's rebuild on the cut
+// mesh and the tear textures' baking) and, of it, the baking; and the
+// tearing stage's share of the step.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "crumple/core/parallel.hpp"
+#include "crumple/io/scene.hpp"
+#include "crumple/pipeline/shot.hpp"
+
+namespace {
+
+using namespace crumple;
+namespace fs = std::filesystem;
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+struct Row {
+  std::string sample;
+  int frames = 0;
+  std::size_t advances = 0;
+  double stepMs = 0.0, tearMs = 0.0, bakeMs = 0.0, share = 0.0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int runs = 3;
+  std::string jsonPath;
+  std::vector<std::string> samples;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--runs" && i + 1 < argc) {
+      runs = std::max(1, std::atoi(argv[++i]));
+    } else if (a == "--json" && i + 1 < argc) {
+      jsonPath = argv[++i];
+    } else if (a == "--help" || a == "-h") {
+      std::printf("usage: bench_tear [SAMPLE ...] [--runs 3] [--json FILE]\n");
+      return 0;
+    } else {
+      samples.push_back(a);
+    }
+  }
+  if (samples.empty()) samples = {"tear-straight", "tear-curved", "tear-notch"};
+  setThreadCount(1);
+  const fs::path scratch = fs::temp_directory_path() / "crumple-bench-tear";
+  std::vector<Row> rows;
+  for (const std::string& name : samples) {
+    const io::SceneSpec scene =
+        io::loadScene(io::resolveScenePath(std::string(CRUMPLE_SOURCE_DIR) + "/samples/" + name));
+    std::vector<double> step, tear, bake, share;
+    Row row;
+    row.sample = name;
+    for (int r = 0; r < runs; ++r) {
+      pipeline::ShotOptions options;
+      options.outDir = (scratch / name).string();
+      options.render = false;
+      options.log = std::fopen("/dev/null", "w");
+      options.interactive = 0;
+      const pipeline::ShotReport report = pipeline::runShot(scene, options);
+      std::fclose(options.log);
+      const double frames = std::max(1, report.framesSimulated - 1);
+      double stepTotal = 0.0;
+      for (const char* s : {"elastic", "geometric", "cones", "rebuild", "isometry", "contacts"})
+        if (const auto it = report.stages.find(s); it != report.stages.end())
+          stepTotal += it->second.totalMs;
+      step.push_back(stepTotal / frames);
+      tear.push_back(report.tearMs / frames);
+      bake.push_back(report.tearBakeMs / frames);
+      share.push_back(stepTotal > 0.0 ? report.tearMs / stepTotal : 0.0);
+      row.frames = report.framesSimulated;
+      row.advances = report.tearAdvances.size();
+    }
+    row.stepMs = median(step);
+    row.tearMs = median(tear);
+    row.bakeMs = median(bake);
+    row.share = median(share);
+    rows.push_back(row);
+    std::printf(
+        "%-14s %3d frames, %2zu tip advances  step %8.2f ms/frame  tearing %6.3f ms/frame (baking "
+        "%6.3f)  %5.2f %% of the step\n",
+        row.sample.c_str(), row.frames, row.advances, row.stepMs, row.tearMs, row.bakeMs,
+        100.0 * row.share);
+    std::fflush(stdout);
+  }
+  std::error_code ignored;
+  fs::remove_all(scratch, ignored);
+  if (!jsonPath.empty()) {
+    std::FILE* f = std::fopen(jsonPath.c_str(), "w");
+    if (f == nullptr) {
+      std::fprintf(stderr, "bench_tear: cannot write %s\n", jsonPath.c_str());
+      return 1;
+    }
+    std::fprintf(f, "{\"runs\": %d, \"samples\": [", runs);
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const Row& r = rows[i];
+      std::fprintf(f,
+                   "%s{\"sample\": \"%s\", \"frames\": %d, \"tip_advances\": %zu, "
+                   "\"step_ms_per_frame\": %.6g, \"tear_ms_per_frame\": %.6g, "
+                   "\"bake_ms_per_frame\": %.6g, \"share_of_step\": %.6g}",
+                   i == 0 ? "" : ", ", r.sample.c_str(), r.frames, r.advances, r.stepMs, r.tearMs,
+                   r.bakeMs, r.share);
+    }
+    std::fprintf(f, "]}\n");
+    std::fclose(f);
+  }
+  return 0;
+}

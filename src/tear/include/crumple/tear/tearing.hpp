@@ -1,0 +1,101 @@
+#pragma once
+// The tearing stage of a shot, frame by frame (thesis 3.3, Fig. 3.14): the
+// frame's candidate tearing points are tested against the Griffith
+// criterion with the forces of the elastic step; every tip that tears
+// advances by V E_r along its propagation direction, and the strongest new
+// candidate that tears starts a tear; the mesh is cut along each advance
+// (cutAlong) and every advance is recorded with its detail path
+// (TearSegment) for the baked tear textures.
+#include <cstdint>
+#include <vector>
+
+#include "crumple/mesh/sheet_mesh.hpp"
+#include "crumple/tear/cut.hpp"
+#include "crumple/tear/detail_path.hpp"
+#include "crumple/tear/fiber_texture.hpp"
+#include "crumple/tear/tear_segment.hpp"
+#include "crumple/tear/tear_step.hpp"
+
+namespace crumple::tear {
+
+struct TearingParams {
+  TearParams griffith;  // C, D, V, the inward-corner angle
+  FiberTextureParams
+      fibers;  // T_fibers; texelSize is the detail's resolution (seed is set by Tearing)
+  DetailPathParams detail;  // p and G_t's width
+  // The tip's advance V E_r is held between these multiples of the mesh's
+  // mean edge length: the mesh cannot show a shorter advance without sliver
+  // triangles (the detail path shows the fine shape), and a longer one per
+  // frame would cut across forces the elastic step has not seen.
+  double minAdvance = 0.5;
+  double maxAdvance = 2.0;
+  double snap = 0.2;            // CutOptions::snap
+  int maxNewTearsPerFrame = 1;  // the strongest candidates (E_r / E_f) start first
+};
+
+// One advance of one tear in a frame.
+struct TearEvent {
+  int tear = -1;
+  bool started = false;                     // this advance started the tear
+  CandidateKind kind = CandidateKind::Tip;  // the candidate it advanced from
+  int vertex = -1;                          // that candidate's vertex
+  double energyRelease = 0.0;               // E_r (N)
+  double fractureEnergy = 0.0;              // E_f (N)
+  Vec2 from = Vec2::Zero();                 // s_t (pattern, m)
+  Vec2 to = Vec2::Zero();                   // s_{t+1} as the mesh took it
+  bool separated = false;                   // the tear reached the boundary: it ends there
+};
+
+struct TearFrameResult {
+  std::vector<CandidateTest> tests;  // every candidate of the frame
+  std::vector<TearEvent> events;     // in the order the cuts were made
+  std::size_t vertexCountBefore = 0;
+  // One per vertex appended this frame, over the vertices before the frame.
+  std::vector<VertexBlend> blends;
+  // Vertices from before the frame that moved onto a cut (CutOptions::snap),
+  // their new place over the vertices before the frame.
+  std::vector<std::pair<int, VertexBlend>> relocated;
+  bool changed() const { return !events.empty(); }
+};
+
+class Tearing {
+ public:
+  // `mesh`: the sheet at the start (its pattern's bounding box sizes the
+  // fiber texture, its mean edge length the advances). Throws
+  // std::invalid_argument for bad parameters.
+  Tearing(const mesh::SheetMesh& mesh, const TearingParams& params, std::uint64_t seed);
+
+  // Tests the frame's candidates (tips, `junctions`, borders of held areas
+  // with held[v] != 0, inward corners; not the vertices of a tear's lips but
+  // its tip) with the elastic step's `forces` and
+  // cuts `mesh` where E_r >= E_f. A cut that cannot be made (the direction
+  // leaves the sheet at once) is skipped and the mesh left as it was.
+  TearFrameResult step(mesh::SheetMesh& mesh, const std::vector<int>& junctions,
+                       const std::vector<char>& held, const VertexForces& forces);
+
+  // Every advance so far, in order.
+  const std::vector<TearSegment>& segments() const { return segments_; }
+  // The tip vertex of each tear, -1 once it has torn through to the boundary.
+  const std::vector<int>& tips() const { return tips_; }
+  // Where each tear started (kind of its first candidate).
+  const std::vector<CandidateKind>& startKinds() const { return startKinds_; }
+  const FiberTexture& fibers() const { return fibers_; }
+  double edgeLength() const { return edgeLength_; }
+
+ private:
+  TearingParams params_;
+  FiberTexture fibers_;
+  double edgeLength_ = 0.0;
+  std::vector<int> tips_;
+  std::vector<char> lip_;  // per vertex: on a tear's lip (not a new candidate)
+  std::vector<CandidateKind> startKinds_;
+  std::vector<TearSegment> segments_;
+};
+
+// Per-vertex values carried over a frame's cuts: values[v] for the old
+// vertices (their blend for the moved ones), the blends for the appended.
+std::vector<Vec3> blendValues(const std::vector<Vec3>& values,
+                              const std::vector<VertexBlend>& blends,
+                              const std::vector<std::pair<int, VertexBlend>>& relocated);
+
+}  // namespace crumple::tear

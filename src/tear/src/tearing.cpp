@@ -1,0 +1,227 @@
+#include "crumple/tear/tearing.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "crumple/tear/candidates.hpp"
+
+namespace crumple::tear {
+
+namespace {
+
+double meanEdgeLength(const mesh::SheetMesh& m) {
+  double sum = 0.0;
+  long count = 0;
+  for (const auto& e : mesh::buildEdges(m)) {
+    sum +=
+        (m.pattern[static_cast<std::size_t>(e.v[1])] - m.pattern[static_cast<std::size_t>(e.v[0])])
+            .norm();
+    ++count;
+  }
+  return count > 0 ? sum / static_cast<double>(count) : 0.0;
+}
+
+FiberTexture fibersOver(const mesh::SheetMesh& m, FiberTextureParams params, std::uint64_t seed) {
+  if (m.pattern.empty()) throw std::invalid_argument("Tearing: an empty mesh");
+  Vec2 lo = m.pattern.front(), hi = m.pattern.front();
+  for (const Vec2& p : m.pattern) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  params.seed = seed;
+  const Vec2 margin = Vec2::Constant(2.0 * params.texelSize);
+  return FiberTexture(lo - margin, hi - lo + 2.0 * margin, params);
+}
+
+// A blend over the mesh before one cut, re-expressed over the mesh before
+// the frame: vertices appended earlier in the frame through their blends
+// (`earlier`, vertex index = count + k), vertices moved earlier in the frame
+// through theirs. More than three terms (cuts of one frame in the same
+// triangles) keep the three heaviest, renormalised.
+VertexBlend resolve(const VertexBlend& b, std::size_t count,
+                    const std::vector<VertexBlend>& earlier,
+                    const std::vector<std::pair<int, VertexBlend>>& moved) {
+  std::vector<std::pair<int, double>> terms;
+  const auto expand = [&](const VertexBlend& e, double w) {
+    for (int k = 0; k < 3; ++k)
+      if (e.vertex[static_cast<std::size_t>(k)] >= 0)
+        terms.emplace_back(e.vertex[static_cast<std::size_t>(k)],
+                           w * e.weight[static_cast<std::size_t>(k)]);
+  };
+  for (int j = 0; j < 3; ++j) {
+    const int v = b.vertex[static_cast<std::size_t>(j)];
+    if (v < 0) continue;
+    const double w = b.weight[static_cast<std::size_t>(j)];
+    if (static_cast<std::size_t>(v) >= count) {
+      expand(earlier.at(static_cast<std::size_t>(v) - count), w);
+      continue;
+    }
+    const auto it =
+        std::find_if(moved.begin(), moved.end(), [&](const auto& m) { return m.first == v; });
+    if (it != moved.end()) {
+      expand(it->second, w);
+    } else {
+      terms.emplace_back(v, w);
+    }
+  }
+  return makeBlend(std::move(terms));
+}
+
+}  // namespace
+
+Tearing::Tearing(const mesh::SheetMesh& mesh, const TearingParams& params, std::uint64_t seed)
+    : params_(params),
+      fibers_(fibersOver(mesh, params.fibers, seed)),
+      edgeLength_(meanEdgeLength(mesh)) {
+  if (!(params.minAdvance > 0.0 && params.maxAdvance >= params.minAdvance))
+    throw std::invalid_argument("Tearing: need 0 < minAdvance <= maxAdvance");
+  if (!(params.griffith.resistance >= 0.0) || !(params.griffith.speed > 0.0) ||
+      !(params.griffith.tipDamage >= 0.0 && params.griffith.tipDamage <= 1.0))
+    throw std::invalid_argument("Tearing: need resistance >= 0, speed > 0, tip damage in [0, 1]");
+  if (params.maxNewTearsPerFrame < 0)
+    throw std::invalid_argument("Tearing: maxNewTearsPerFrame must be >= 0");
+  if (!(edgeLength_ > 0.0)) throw std::invalid_argument("Tearing: a mesh without edges");
+}
+
+TearFrameResult Tearing::step(mesh::SheetMesh& mesh, const std::vector<int>& junctions,
+                              const std::vector<char>& held, const VertexForces& forces) {
+  TearFrameResult result;
+  result.vertexCountBefore = mesh.vertexCount();
+  std::vector<int> activeTips;
+  for (int v : tips_)
+    if (v >= 0) activeTips.push_back(v);
+  result.tests =
+      testCandidates(mesh, fibers_, activeTips, junctions, held, forces, params_.griffith);
+  // A tear's lips are not new candidates: the kinks of their chains are not
+  // corners of the paper's outline.
+  lip_.resize(mesh.vertexCount(), 0);
+  std::erase_if(result.tests, [&](const CandidateTest& t) {
+    return t.candidate.kind != CandidateKind::Tip &&
+           lip_[static_cast<std::size_t>(t.candidate.vertex)] != 0;
+  });
+
+  // What advances this frame: every tip that tears, then the strongest new
+  // starts (by E_r / E_f, then vertex).
+  struct Advance {
+    const CandidateTest* test;
+    int tear;
+  };
+  std::vector<Advance> advances;
+  std::vector<const CandidateTest*> starts;
+  for (const CandidateTest& t : result.tests) {
+    if (!t.tears) continue;
+    if (t.candidate.kind == CandidateKind::Tip) {
+      const auto it = std::find(tips_.begin(), tips_.end(), t.candidate.vertex);
+      advances.push_back({&t, static_cast<int>(it - tips_.begin())});
+    } else {
+      starts.push_back(&t);
+    }
+  }
+  const auto strength = [](const CandidateTest* t) {
+    return t->propagation.energyRelease / std::max(t->fractureEnergy, 1e-300);
+  };
+  std::stable_sort(
+      starts.begin(), starts.end(),
+      [&](const CandidateTest* a, const CandidateTest* b) { return strength(a) > strength(b); });
+  for (std::size_t k = 0; k < starts.size() && static_cast<int>(k) < params_.maxNewTearsPerFrame;
+       ++k)
+    advances.push_back({starts[k], -1});
+
+  for (const Advance& a : advances) {
+    const CandidateTest& t = *a.test;
+    const int vertex = t.candidate.vertex;
+    const Vec2 from = mesh.pattern[static_cast<std::size_t>(vertex)];
+    // s_{t+1} = s_t + V E_r d_prop (thesis 3.3.3), the step held to what the mesh can show.
+    const double length =
+        std::clamp(params_.griffith.speed * t.propagation.energyRelease,
+                   params_.minAdvance * edgeLength_, params_.maxAdvance * edgeLength_);
+    const Vec2 to = from + length * t.propagation.direction;
+    mesh::SheetMesh trial = mesh;
+    CutResult cut;
+    try {
+      CutOptions options;
+      options.snap = params_.snap;
+      options.fixed = &held;
+      cut = cutAlong(trial, vertex, to, options);
+    } catch (const std::invalid_argument&) {
+      continue;  // the direction leaves the sheet here: no tear from this point
+    }
+    if (cut.chain.size() < 2) continue;
+    mesh = std::move(trial);
+    lip_.resize(mesh.vertexCount(), 0);
+    for (int v : cut.chain) lip_[static_cast<std::size_t>(v)] = 1;
+    for (int v : cut.twins) lip_[static_cast<std::size_t>(v)] = 1;
+    // Moved vertices first: appended ones' blends may name them.
+    std::vector<std::pair<int, VertexBlend>> moved;
+    for (const auto& [v, b] : cut.relocated)
+      moved.emplace_back(v, resolve(b, result.vertexCountBefore, result.blends, result.relocated));
+    for (const VertexBlend& b : cut.blends)
+      result.blends.push_back(
+          resolve(b, result.vertexCountBefore, result.blends, result.relocated));
+    for (const auto& [v, b] : moved) {
+      if (static_cast<std::size_t>(v) >= result.vertexCountBefore) {
+        result.blends[static_cast<std::size_t>(v) - result.vertexCountBefore] = b;
+        continue;
+      }
+      const auto it = std::find_if(result.relocated.begin(), result.relocated.end(),
+                                   [&](const auto& m) { return m.first == v; });
+      if (it != result.relocated.end()) {
+        it->second = b;
+      } else {
+        result.relocated.emplace_back(v, b);
+      }
+    }
+
+    TearEvent e;
+    e.started = a.tear < 0;
+    e.tear = e.started ? static_cast<int>(tips_.size()) : a.tear;
+    if (e.started) {
+      tips_.push_back(-1);
+      startKinds_.push_back(t.candidate.kind);
+    }
+    tips_[static_cast<std::size_t>(e.tear)] = cut.separated ? -1 : cut.tip;
+    e.kind = t.candidate.kind;
+    e.vertex = vertex;
+    e.energyRelease = t.propagation.energyRelease;
+    e.fractureEnergy = t.fractureEnergy;
+    e.from = from;
+    e.to = mesh.pattern[static_cast<std::size_t>(cut.chain.back())];
+    e.separated = cut.separated;
+    result.events.push_back(e);
+
+    TearSegment s;
+    s.tear = e.tear;
+    for (int v : cut.chain) s.cut.push_back(mesh.pattern[static_cast<std::size_t>(v)]);
+    s.detail = detailPath(fibers_, e.from, e.to, params_.detail);
+    segments_.push_back(std::move(s));
+  }
+  return result;
+}
+
+std::vector<Vec3> blendValues(const std::vector<Vec3>& values,
+                              const std::vector<VertexBlend>& blends,
+                              const std::vector<std::pair<int, VertexBlend>>& relocated) {
+  const auto apply = [&](const VertexBlend& b) {
+    Vec3 v = Vec3::Zero();
+    for (int k = 0; k < 3; ++k)
+      if (b.vertex[static_cast<std::size_t>(k)] >= 0)
+        v += b.weight[static_cast<std::size_t>(k)] *
+             values.at(static_cast<std::size_t>(b.vertex[static_cast<std::size_t>(k)]));
+    return v;
+  };
+  std::vector<Vec3> out = values;
+  for (const auto& [v, b] : relocated) out.at(static_cast<std::size_t>(v)) = apply(b);
+  out.reserve(values.size() + blends.size());
+  for (const VertexBlend& b : blends) {
+    Vec3 v = Vec3::Zero();
+    for (int k = 0; k < 3; ++k)
+      if (b.vertex[static_cast<std::size_t>(k)] >= 0)
+        v += b.weight[static_cast<std::size_t>(k)] *
+             values.at(static_cast<std::size_t>(b.vertex[static_cast<std::size_t>(k)]));
+    out.push_back(v);
+  }
+  return out;
+}
+
+}  // namespace crumple::tear
