@@ -20,17 +20,12 @@
 #include "crumple/core/parallel.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/shot.hpp"
+#include "shot_bench.hpp"
 
 namespace {
 
 using namespace crumple;
 namespace fs = std::filesystem;
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 struct Row {
   std::string sample;
@@ -42,23 +37,17 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int runs = 3;
-  std::string jsonPath;
-  std::vector<std::string> samples;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--runs" && i + 1 < argc) {
-      runs = std::max(1, std::atoi(argv[++i]));
-    } else if (a == "--json" && i + 1 < argc) {
-      jsonPath = argv[++i];
-    } else if (a == "--help" || a == "-h") {
-      std::printf("usage: bench_contacts [SAMPLE ...] [--runs 3] [--json FILE]\n");
-      return 0;
-    } else {
-      samples.push_back(a);
-    }
+  const bench::ShotBenchArgs args = bench::parseShotBenchArgs(argc, argv);
+  if (args.help) {
+    std::printf("usage: bench_contacts [SAMPLE ...] [--runs 3] [--json FILE]\n");
+    return 0;
   }
-  if (samples.empty()) samples = {"slide-on-table", "press-on-sphere", "fold-over"};
+  const int runs = args.runs;
+  const std::string jsonPath = args.jsonPath;
+  const std::vector<std::string> samples =
+      args.samples.empty()
+          ? std::vector<std::string>{"slide-on-table", "press-on-sphere", "fold-over"}
+          : args.samples;
   setThreadCount(1);
   const fs::path scratch = fs::temp_directory_path() / "crumple-bench-contacts";
   std::vector<Row> rows;
@@ -91,11 +80,11 @@ int main(int argc, char** argv) {
       row.depth = report.maxContactDepth;
       row.selfSubsteps = report.selfContactSteps;
     }
-    row.stepMs = median(step);
-    row.colliderMs = median(collider);
-    row.selfMs = median(self);
-    row.share = median(share);
-    row.checkMs = median(check);
+    row.stepMs = bench::median(step);
+    row.colliderMs = bench::median(collider);
+    row.selfMs = bench::median(self);
+    row.share = bench::median(share);
+    row.checkMs = bench::median(check);
     rows.push_back(row);
     std::printf(
         "%-16s %3d frames  step %8.2f ms/frame  colliders %6.2f  self-contact %6.2f ms/frame "

@@ -19,17 +19,12 @@
 #include "crumple/core/parallel.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/shot.hpp"
+#include "shot_bench.hpp"
 
 namespace {
 
 using namespace crumple;
 namespace fs = std::filesystem;
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 struct Row {
   std::string sample;
@@ -41,23 +36,16 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int runs = 3;
-  std::string jsonPath;
-  std::vector<std::string> samples;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--runs" && i + 1 < argc) {
-      runs = std::max(1, std::atoi(argv[++i]));
-    } else if (a == "--json" && i + 1 < argc) {
-      jsonPath = argv[++i];
-    } else if (a == "--help" || a == "-h") {
-      std::printf("usage: bench_tear [SAMPLE ...] [--runs 3] [--json FILE]\n");
-      return 0;
-    } else {
-      samples.push_back(a);
-    }
+  const bench::ShotBenchArgs args = bench::parseShotBenchArgs(argc, argv);
+  if (args.help) {
+    std::printf("usage: bench_tear [SAMPLE ...] [--runs 3] [--json FILE]\n");
+    return 0;
   }
-  if (samples.empty()) samples = {"tear-straight", "tear-curved", "tear-notch"};
+  const int runs = args.runs;
+  const std::string jsonPath = args.jsonPath;
+  const std::vector<std::string> samples =
+      args.samples.empty() ? std::vector<std::string>{"tear-straight", "tear-curved", "tear-notch"}
+                           : args.samples;
   setThreadCount(1);
   const fs::path scratch = fs::temp_directory_path() / "crumple-bench-tear";
   std::vector<Row> rows;
@@ -87,10 +75,10 @@ int main(int argc, char** argv) {
       row.frames = report.framesSimulated;
       row.advances = report.tearAdvances.size();
     }
-    row.stepMs = median(step);
-    row.tearMs = median(tear);
-    row.bakeMs = median(bake);
-    row.share = median(share);
+    row.stepMs = bench::median(step);
+    row.tearMs = bench::median(tear);
+    row.bakeMs = bench::median(bake);
+    row.share = bench::median(share);
     rows.push_back(row);
     std::printf(
         "%-14s %3d frames, %2zu tip advances  step %8.2f ms/frame  tearing %6.3f ms/frame (baking "

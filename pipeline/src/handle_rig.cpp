@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <stdexcept>
 
 #include "crumple/core/error.hpp"
 
@@ -155,6 +156,14 @@ void HandleRig::pins(double t, std::vector<sim::Pin>& out) const {
     for (std::size_t k = 0; k < h.tangentVertices.size(); ++k)
       out.push_back({h.tangentVertices[k], pose.position + pose.rotation * h.tangentOffsets[k]});
   }
+}
+
+void HandleRig::rebind(const mesh::SheetMesh& sheet, const std::vector<int>& handleVertices,
+                       double t) {
+  if (handleVertices.size() != handles_.size())
+    throw std::invalid_argument("HandleRig::rebind: one vertex per handle");
+  for (std::size_t h = 0; h < handles_.size(); ++h) handles_[h].vertex = handleVertices[h];
+  rebindTangents(sheet, t);
 }
 
 void HandleRig::rebindTangents(const mesh::SheetMesh& sheet, double t) {

@@ -178,6 +178,65 @@ tear::TearingParams tearingParamsOf(const io::TearSpec& t) {
   return p;
 }
 
+// A torn crumpling-model sheet handed over to the elastic model settles in
+// these tiny steps (s) before it moves on.
+constexpr int kRelaxSteps = 4;
+constexpr double kRelaxDt = 1e-4;
+
+// The crumpling model's sheet at the elastic model's resolution (a torn
+// sheet handed over, docs/TEARING.md): the scene's rectangle mesh, the
+// vertex nearest each handle's point moved onto it, every vertex placed and
+// given a velocity by interpolating S_P (positions x, velocities v) in the
+// pattern.
+struct ResampledSheet {
+  mesh::SheetMesh mesh;
+  std::vector<Vec3> velocities;
+  std::vector<int> handleVertices;
+};
+ResampledSheet resampleSheet(const mesh::SheetMesh& fine, const mesh::SheetMesh& sp,
+                             const std::vector<Vec3>& x, const std::vector<Vec3>& v,
+                             const std::vector<int>& spHandles) {
+  ResampledSheet out;
+  out.mesh = fine;
+  for (int h : spHandles) {
+    const Vec2 p = sp.pattern[static_cast<std::size_t>(h)];
+    const int n = mesh::nearestPatternVertex(out.mesh, p);
+    if (std::find(out.handleVertices.begin(), out.handleVertices.end(), n) !=
+        out.handleVertices.end())
+      throw std::invalid_argument(
+          "two handles fall on one vertex of the elastic mesh (a finer [sheet] max_edge "
+          "separates them)");
+    out.mesh.pattern[static_cast<std::size_t>(n)] = p;
+    out.handleVertices.push_back(n);
+  }
+  const auto cross = [](const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); };
+  out.velocities.resize(out.mesh.vertexCount());
+  for (std::size_t i = 0; i < out.mesh.vertexCount(); ++i) {
+    const Vec2 q = out.mesh.pattern[i];
+    double bestMin = -std::numeric_limits<double>::infinity();
+    Vec3 bx = Vec3::Zero(), bv = Vec3::Zero();
+    for (const auto& t : sp.triangles) {
+      const Vec2 a = sp.pattern[static_cast<std::size_t>(t[0])];
+      const Vec2 b = sp.pattern[static_cast<std::size_t>(t[1])];
+      const Vec2 c = sp.pattern[static_cast<std::size_t>(t[2])];
+      const double area = cross(b - a, c - a);
+      if (!(std::abs(area) > 1e-14)) continue;  // a sliver cannot place anything
+      const double wb = cross(q - a, c - a) / area, wc = cross(b - a, q - a) / area;
+      const double wa = 1.0 - wb - wc;
+      const double least = std::min({wa, wb, wc});
+      if (!(least > bestMin)) continue;
+      bestMin = least;
+      bx = wa * x[static_cast<std::size_t>(t[0])] + wb * x[static_cast<std::size_t>(t[1])] +
+           wc * x[static_cast<std::size_t>(t[2])];
+      bv = wa * v[static_cast<std::size_t>(t[0])] + wb * v[static_cast<std::size_t>(t[1])] +
+           wc * v[static_cast<std::size_t>(t[2])];
+    }
+    out.mesh.positions[i] = bx;
+    out.velocities[i] = bv;
+  }
+  return out;
+}
+
 void validateRange(const io::SceneSpec& scene, const FrameRange& range) {
   if (range.first < scene.frameStart || range.last > scene.frameEnd)
     throw InputError(
@@ -557,38 +616,83 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
                      t.tears ? " tears" : "");
       }
     if (r.changed()) {
-      for (const auto& e : r.events) {
-        report.tearAdvances.push_back({frame, e});
-        if (report.firstTearFrame < 0) report.firstTearFrame = frame;
-      }
-      // The elastic model on the cut mesh: velocities carried over the cut,
-      // each uncut hinge's rest angle and stiffness factor kept (the
-      // crumpling model's fiber damage, thesis 2.3.3).
-      const std::vector<Vec3> velocities =
-          tear::blendValues(model.velocities(), r.blends, r.relocated);
-      std::map<std::pair<int, int>, std::pair<double, double>> hingeState;
-      for (std::size_t h = 0; h < model.hinges().size(); ++h)
-        hingeState[{model.hinges()[h].v[0], model.hinges()[h].v[1]}] = {
-            model.hingeRestAngle(h), model.hingeStiffnessFactor(h)};
+      std::vector<tear::TearEvent> events = r.events;
       carriedContacts = hybrid ? hybrid->contacts() : model.contacts();
-      sim::ElasticSheet next(sheet, materialOf(scene.paper), params);
-      next.setVelocities(velocities);
-      next.setContacts(contact);
-      for (std::size_t h = 0; h < next.hinges().size(); ++h) {
-        const auto it = hingeState.find({next.hinges()[h].v[0], next.hinges()[h].v[1]});
-        if (it == hingeState.end()) continue;
-        next.setHingeRestAngle(h, it->second.first);
-        next.setHingeStiffnessFactor(h, it->second.second);
-      }
-      elastic.emplace(std::move(next));
       if (hybrid) {
         // The geometric layer cannot be cut (docs/TEARING.md): from its first
-        // tear on, the sheet goes on as the elastic model on its S_P.
+        // tear on, the sheet goes on as the elastic model on the scene's
+        // rectangle mesh, placed and moving as S_P, its tears made again on
+        // it, its handles on the vertices nearest their points.
+        std::vector<int> spHandles;
+        for (const auto& h : rig.handles()) spHandles.push_back(h.vertex);
+        const mesh::SheetMesh& sp = hybrid->physical().mesh;
+        std::optional<ResampledSheet> resampled;
+        std::optional<tear::Tearing> freshTearing;
+        tear::TearFrameResult replayed;
+        try {
+          resampled = resampleSheet(buildSheet(scene, animation.get()), sp, model.positions(),
+                                    model.velocities(), spHandles);
+          freshTearing.emplace(resampled->mesh, tearingParamsOf(scene.tear), seed);
+          std::vector<char> fineHeld(resampled->mesh.vertexCount(), 0);
+          for (int v : resampled->handleVertices) fineHeld[static_cast<std::size_t>(v)] = 1;
+          replayed = freshTearing->replay(resampled->mesh, r.events, fineHeld);
+        } catch (const std::exception& e) {
+          throw NumericalError("tear handover", frame, e.what());
+        }
+        ResampledSheet& fine = *resampled;
+        tear::Tearing& fresh = *freshTearing;
+        events = replayed.events;
+        sheet = std::move(fine.mesh);
+        const std::vector<Vec3> velocities =
+            tear::blendValues(fine.velocities, replayed.blends, replayed.relocated);
+        tearing.emplace(std::move(fresh));
+        rig.rebind(sheet, fine.handleVertices, frameTime(scene, frame));
+        carriedContacts.reset();  // S_P's vertices: the next frame's contacts are the fine mesh's
+        elastic.emplace(sheet, materialOf(scene.paper), params);
+        elastic->setContacts(contact);
+        // Interpolating S_P's long thin cells does not keep the fine mesh's
+        // edge lengths: it settles first, with its pins where they are, in
+        // a few tiny implicit steps (kRelaxSteps of kRelaxDt), then takes
+        // S_P's velocities.
+        const double t = frameTime(scene, frame);
+        try {
+          for (int k = 0; k < kRelaxSteps; ++k)
+            (void)elastic->advance(t - kRelaxDt, kRelaxDt, pins);
+        } catch (const NumericalError& e) {
+          throw NumericalError("tear handover", frame, e.problem());
+        }
+        elastic->setVelocities(velocities);
+        sheet.positions = elastic->positions();
         hybrid.reset();
         report.tearHandoverFrame = frame;
+        report.vertices = sheet.vertexCount();
         report.notes.push_back("the sheet tore at frame " + std::to_string(frame) +
                                ": from there on it is simulated by the elastic model on the "
-                               "crumpling model's last S_P (the geometric layer is not cut)");
+                               "scene's rectangle mesh (the crumpling model's geometric layer is "
+                               "not cut)");
+      } else {
+        // The elastic model on the cut mesh: velocities carried over the cut,
+        // each uncut hinge's rest angle and stiffness factor kept.
+        const std::vector<Vec3> velocities =
+            tear::blendValues(model.velocities(), r.blends, r.relocated);
+        std::map<std::pair<int, int>, std::pair<double, double>> hingeState;
+        for (std::size_t h = 0; h < model.hinges().size(); ++h)
+          hingeState[{model.hinges()[h].v[0], model.hinges()[h].v[1]}] = {
+              model.hingeRestAngle(h), model.hingeStiffnessFactor(h)};
+        sim::ElasticSheet next(sheet, materialOf(scene.paper), params);
+        next.setVelocities(velocities);
+        next.setContacts(contact);
+        for (std::size_t h = 0; h < next.hinges().size(); ++h) {
+          const auto it = hingeState.find({next.hinges()[h].v[0], next.hinges()[h].v[1]});
+          if (it == hingeState.end()) continue;
+          next.setHingeRestAngle(h, it->second.first);
+          next.setHingeStiffnessFactor(h, it->second.second);
+        }
+        elastic.emplace(std::move(next));
+      }
+      for (const auto& e : events) {
+        report.tearAdvances.push_back({frame, e});
+        if (report.firstTearFrame < 0) report.firstTearFrame = frame;
       }
       const auto bakeStart = Clock::now();
       tear::TearAtlasParams atlas;

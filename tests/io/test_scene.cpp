@@ -1022,3 +1022,47 @@ TEST(SceneContact, SelfRejectsOtherValues) {
 
 }  // namespace
 }  // namespace crumple::io
+
+namespace crumple::io {
+namespace {
+
+TEST(Scene, SheetOutlineIsAPolygonInSceneUnitsTurnedCounterClockwise) {
+  // Clockwise as written, in cm: an L whose inward corner is at [5, 5].
+  const SceneSpec s = parse(
+      "[scene]\nunits = \"cm\"\n[sheet]\noutline = [[0, 0], [0, 10], [5, 10], [5, 5], [12, 5], "
+      "[12, 0]]\nmax_edge = 0.5\n");
+  ASSERT_EQ(s.sheet.kind, SheetSpec::Kind::Outline);
+  ASSERT_EQ(s.sheet.outline.size(), 6u);
+  double area = 0.0;
+  for (std::size_t i = 0; i < 6; ++i) {
+    const Vec2& a = s.sheet.outline[i];
+    const Vec2& b = s.sheet.outline[(i + 1) % 6];
+    area += 0.5 * (a.x() * b.y() - a.y() * b.x());
+  }
+  EXPECT_NEAR(area, 0.0085, 1e-12) << "counter-clockwise, in m^2";
+  EXPECT_DOUBLE_EQ(s.sheet.width, 0.12);
+  EXPECT_DOUBLE_EQ(s.sheet.height, 0.10);
+  EXPECT_FALSE(s.tear.enabled) << "no [tear]: no tearing";
+}
+
+TEST(Scene, BadOutlinesAndTearKeysSayWhatIsWrong) {
+  expectError("[sheet]\noutline = [[0, 0], [1, 0]]\n", 2, "sheet.outline", {"at least 3"});
+  expectError("[sheet]\noutline = [[0, 0], [4, 0], [1, 1], [3, 2], [2, 0.5]]\n", 2, "sheet.outline",
+              {"simple polygon"});
+  expectError("[sheet]\noutline = [[0, 0], [1, 0], [-1, 1]]\n", 2, "sheet.outline",
+              {"not negative"});
+  expectError("[sheet]\noutline = [[0, 0], [1, 0], [0, 1]]\nwidth = 2\n", 2, "sheet.outline",
+              {"one of"});
+  expectError(kSheet + "[tear]\ntip_damage = 2\n", 5, "tear.tip_damage", {"[0, 1]"});
+  expectError(kSheet + "[tear]\nfiber_anisotropy = 0.5\n", 5, "tear.fiber_anisotropy", {">= 1"});
+  expectError(kSheet + "[tear]\nspeed = 1\n", 5, "tear.speed", {"unknown key"});
+  const SceneSpec off = parse(kSheet + "[tear]\nenabled = false\n");
+  EXPECT_FALSE(off.tear.enabled);
+  const SceneSpec on = parse(kSheet + "[tear]\nresistance = 0.01\ntexel_mm = 0.5\n");
+  EXPECT_TRUE(on.tear.enabled);
+  EXPECT_DOUBLE_EQ(on.tear.resistance, 0.01);
+  EXPECT_DOUBLE_EQ(on.tear.texel, 5e-4);
+}
+
+}  // namespace
+}  // namespace crumple::io

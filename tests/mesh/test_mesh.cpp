@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <stdexcept>
+
 #include "crumple/mesh/sheet_mesh.hpp"
 
 using namespace crumple;
@@ -84,3 +87,33 @@ TEST(RectangleSheet, RejectsBadSizes) {
   EXPECT_THROW(makeRectangleSheet(1.0, 1.0, std::numeric_limits<double>::quiet_NaN()),
                std::invalid_argument);
 }
+
+namespace crumple::mesh {
+namespace {
+
+TEST(PolygonSheet, AnLShapeIsCoveredExactlyWithEveryOutlinePointAVertex) {
+  const std::vector<Vec2> outline = {{0, 0},       {0.12, 0},    {0.12, 0.05},
+                                     {0.05, 0.05}, {0.05, 0.10}, {0, 0.10}};
+  const SheetMesh m = makePolygonSheet(outline, 0.005);
+  EXPECT_EQ(validate(m), "");
+  double area = 0.0, longest = 0.0;
+  for (const auto& t : m.triangles) {
+    const Vec2 a = m.pattern[static_cast<std::size_t>(t[0])];
+    const Vec2 b = m.pattern[static_cast<std::size_t>(t[1])];
+    const Vec2 c = m.pattern[static_cast<std::size_t>(t[2])];
+    const double cross = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+    EXPECT_GT(cross, 0.0) << "counter-clockwise";
+    area += 0.5 * cross;
+    longest = std::max({longest, (b - a).norm(), (c - b).norm(), (a - c).norm()});
+  }
+  EXPECT_NEAR(area, 0.0085, 1e-12);
+  EXPECT_LT(longest, 1.5 * 0.005);
+  for (const Vec2& p : outline)
+    EXPECT_LT((m.pattern[static_cast<std::size_t>(nearestPatternVertex(m, p))] - p).norm(), 1e-12);
+  EXPECT_THROW(makePolygonSheet({{0, 0}, {0, 1}, {1, 0}}, 0.1), std::invalid_argument)
+      << "clockwise";
+  EXPECT_THROW(makePolygonSheet(outline, 0.0), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace crumple::mesh

@@ -15,6 +15,7 @@
 #include "crumple/exporters/pcache_tear.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
+#include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/shot.hpp"
 #include "crumple/tear/candidates.hpp"
 #include "crumple/tear/detail_path.hpp"
@@ -32,16 +33,22 @@ struct TearShot {
   cache::FrameRecord last;  // the final frame
 };
 
-TearShot runTearSample(const std::string& sample, const TempDir& dir, const std::string& sub = "") {
-  TearShot shot;
-  shot.scene = io::loadScene(io::resolveScenePath(sourcePath("samples/" + sample)));
+// Simulates `scene` into `out` quietly, without rendering.
+pipeline::ShotReport simulate(const io::SceneSpec& scene, const std::string& out) {
   pipeline::ShotOptions options;
-  options.outDir = (dir / (sample + sub)).string();
+  options.outDir = out;
   options.render = false;
   options.log = std::fopen("/dev/null", "w");
   options.interactive = 0;
-  shot.report = pipeline::runShot(shot.scene, options);
+  pipeline::ShotReport report = pipeline::runShot(scene, options);
   std::fclose(options.log);
+  return report;
+}
+
+TearShot runTearSample(const std::string& sample, const TempDir& dir, const std::string& sub = "") {
+  TearShot shot;
+  shot.scene = io::loadScene(io::resolveScenePath(sourcePath("samples/" + sample)));
+  shot.report = simulate(shot.scene, (dir / (sample + sub)).string());
   const cache::CacheReader reader(shot.report.cachePath);
   shot.last = reader.readFrame(reader.frameCount() - 1);
   return shot;
@@ -200,13 +207,7 @@ TEST(TearSamples, ASceneWithoutTearNeverTears) {
   io::SceneSpec scene = io::loadScene(io::resolveScenePath(sourcePath("samples/tear-notch")));
   scene.tear.enabled = false;
   scene.frameEnd = 30;
-  pipeline::ShotOptions options;
-  options.outDir = (dir / "off").string();
-  options.render = false;
-  options.log = std::fopen("/dev/null", "w");
-  options.interactive = 0;
-  const auto r = pipeline::runShot(scene, options);
-  std::fclose(options.log);
+  const auto r = simulate(scene, (dir / "off").string());
   EXPECT_FALSE(r.tearingOn);
   EXPECT_TRUE(r.tearAdvances.empty());
   EXPECT_EQ(r.stages.count("tear"), 0u);
@@ -219,35 +220,65 @@ TEST(TearSamples, ASceneWithoutTearNeverTears) {
 
 namespace {
 
+TEST(TearSamples, TearCylinderStartsAtAJunctionPoint) {
+  // Thesis Fig. 3.26: the crumpling model's half tube tears at a junction
+  // point between its curved region and a flat one, then goes on as the
+  // elastic model (docs/TEARING.md).
+  const TempDir dir;
+  const TearShot shot = runTearSample("tear-cylinder", dir);
+  const auto& r = shot.report;
+  EXPECT_EQ(r.error, "");
+  ASSERT_FALSE(r.tearStartKinds.empty());
+  EXPECT_EQ(r.tearStartKinds[0], tear::CandidateKind::Junction);
+  EXPECT_EQ(r.tearHandoverFrame, r.firstTearFrame);
+  const double opening = lipOpening(shot);
+  // c_mean before and after the tear: the crumpling model's own, and the
+  // torn elastic sheet's (reported, not asserted: the 0.5 % is
+  // missed here, docs/TEARING.md "Not done").
+  const cache::CacheReader reader(r.cachePath);
+  double before = 0.0, after = 0.0;
+  for (std::size_t k = 0; k < reader.frameCount(); ++k) {
+    const auto f = reader.readFrame(k);
+    double& worst = f.frame >= r.firstTearFrame ? after : before;
+    worst = std::max(worst, pipeline::measureFrame(f).cMean);
+  }
+  std::printf(
+      "[ measure ] tear-cylinder: %zu tear(s) (the first from a junction at frame %d), "
+      "%zu advances; lips %.2f mm apart; c_mean at most %.3f %% before the tear, %.3f %% "
+      "after; detail path %.3f x the tips' segments\n",
+      r.tearStartKinds.size(), r.firstTearFrame, r.tearAdvances.size(), 1e3 * opening,
+      100.0 * before, 100.0 * after, detailRatio(r));
+  EXPECT_GT(opening, 2e-3);
+  EXPECT_GE(detailRatio(r), 1.15);
+}
+
 TEST(TearSamples, TheCrumplingModelTearsAtAJunctionAndGoesOnElastic) {
   // cylinder-fold with [tear]: as its tube bends, the sheet tears at a
-  // junction point of S_G (thesis 3.3.2) at frame 62 and goes on as the
-  // elastic model on the last S_P, cut. (The elastic model on that coarse
-  // S_P fails to converge two frames later: docs/TEARING.md "Not done".)
+  // junction point of S_G (thesis 3.3.2) and goes on as the elastic model
+  // on the scene's rectangle mesh to the end.
   const TempDir dir;
   io::SceneSpec scene = io::loadScene(io::resolveScenePath(sourcePath("samples/cylinder-fold")));
   scene.tear.enabled = true;
-  scene.frameEnd = 63;
-  pipeline::ShotOptions options;
-  options.outDir = (dir / "cylinder").string();
-  options.render = false;
-  options.log = std::fopen("/dev/null", "w");
-  options.interactive = 0;
-  const auto r = pipeline::runShot(scene, options);
-  std::fclose(options.log);
+  const auto r = simulate(scene, (dir / "cylinder").string());
   EXPECT_EQ(r.error, "");
   ASSERT_FALSE(r.tearStartKinds.empty());
   EXPECT_EQ(r.tearStartKinds[0], tear::CandidateKind::Junction);
   EXPECT_GT(r.firstTearFrame, 0);
   EXPECT_EQ(r.tearHandoverFrame, r.firstTearFrame);
-  std::printf(
-      "[ measure ] cylinder-fold with [tear]: tore at frame %d at a junction, %zu advances; "
-      "c_mean max %.2f %% (frame %d)\n",
-      r.firstTearFrame, r.tearAdvances.size(), 100.0 * r.maxCMean, r.maxCMeanFrame);
   const cache::CacheReader reader(r.cachePath);
-  const auto last = reader.readFrame(reader.frameCount() - 1);
-  EXPECT_TRUE(cache::decodeTearAtlas(last.extensions).has_value()) << "the torn frames carry TEAR";
-  EXPECT_FALSE(cache::decodeTearAtlas(reader.readFrame(0).extensions).has_value());
+  double torn = 0.0;  // c_mean over the frames after the tear
+  for (std::size_t k = 0; k < reader.frameCount(); ++k) {
+    const auto f = reader.readFrame(k);
+    EXPECT_EQ(cache::decodeTearAtlas(f.extensions).has_value(), f.frame >= r.firstTearFrame)
+        << "frame " << f.frame;
+    if (f.frame >= r.firstTearFrame) torn = std::max(torn, pipeline::measureFrame(f).cMean);
+  }
+  std::printf(
+      "[ measure ] cylinder-fold with [tear]: tore at frame %d at a junction, %zu "
+      "advances, ran on to frame %d; c_mean of the torn frames at most %.4f %%\n",
+      r.firstTearFrame, r.tearAdvances.size(), reader.readFrame(reader.frameCount() - 1).frame,
+      100.0 * torn);
+  EXPECT_LE(torn, 0.005);
 }
 
 }  // namespace

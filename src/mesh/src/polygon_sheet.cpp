@@ -6,18 +6,13 @@
 #include <limits>
 #include <stdexcept>
 
+#include "crumple/core/geometry2d.hpp"
 #include "crumple/mesh/delaunay.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
 
 namespace crumple::mesh {
 
 namespace {
-
-double distanceToSegment(const Vec2& p, const Vec2& a, const Vec2& b) {
-  const Vec2 ab = b - a;
-  const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
-  return (p - (a + t * ab)).norm();
-}
 
 bool insidePolygon(const Vec2& p, const std::vector<Vec2>& poly) {
   bool inside = false;

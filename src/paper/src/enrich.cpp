@@ -10,6 +10,7 @@
 #include <string>
 #include <utility>
 
+#include "crumple/core/geometry2d.hpp"
 #include "crumple/mesh/delaunay.hpp"
 
 namespace crumple::paper {
@@ -25,13 +26,6 @@ const Vec2& patternOf(const GeometricMesh& g, int v) {
 
 const GeometricFace& faceOf(const GeometricMesh& g, int f) {
   return g.faces[static_cast<std::size_t>(f)];
-}
-
-double segmentDistance(const Vec2& p, const Vec2& a, const Vec2& b) {
-  const Vec2 d = b - a;
-  const double len2 = d.squaredNorm();
-  const double t = len2 > 0.0 ? std::clamp((p - a).dot(d) / len2, 0.0, 1.0) : 0.0;
-  return (p - (a + t * d)).norm();
 }
 
 // Where a pattern point lies in an S_G face: the smallest barycentric
@@ -183,7 +177,7 @@ class Builder {
     const auto borderDistance = [&](const Vec2& p) {
       double d = std::numeric_limits<double>::infinity();
       for (const BorderEdge& e : border)
-        d = std::min(d, segmentDistance(p, patternOf(g_, e.a), patternOf(g_, e.b)));
+        d = std::min(d, distanceToSegment(p, patternOf(g_, e.a), patternOf(g_, e.b)));
       return d;
     };
 

@@ -42,25 +42,37 @@ std::vector<std::vector<int>> boundaryLoops(const mesh::SheetMesh& mesh) {
   return loops;
 }
 
-std::vector<int> inwardCorners(const mesh::SheetMesh& mesh, double minAngle) {
-  std::vector<int> out;
+namespace {
+
+// The sheet's interior angle at every boundary vertex (-1 elsewhere): the
+// sheet is on the left of its loop, so the angle at a vertex runs
+// counter-clockwise from the outgoing edge to the incoming one; two edges
+// along the same line are the tip of a slit (2 pi).
+std::vector<double> interiorAngles(const mesh::SheetMesh& mesh) {
+  std::vector<double> angle(mesh.vertexCount(), -1.0);
   for (const auto& loop : boundaryLoops(mesh)) {
     const std::size_t n = loop.size();
     for (std::size_t i = 0; i < n; ++i) {
       const Vec2& prev = mesh.pattern[static_cast<std::size_t>(loop[(i + n - 1) % n])];
       const Vec2& here = mesh.pattern[static_cast<std::size_t>(loop[i])];
       const Vec2& next = mesh.pattern[static_cast<std::size_t>(loop[(i + 1) % n])];
-      // The sheet is on the left of the loop: its angle at `here` runs
-      // counter-clockwise from the outgoing edge to the incoming one; two
-      // edges along the same line are the tip of a slit (2 pi).
       const Vec2 out1 = next - here, in1 = prev - here;
       double interior = std::atan2(out1.x() * in1.y() - out1.y() * in1.x(), out1.dot(in1));
       if (interior < 0.0) interior += 2.0 * std::numbers::pi;
       if (interior < 1e-9) interior = 2.0 * std::numbers::pi;
-      if (interior > std::numbers::pi + minAngle) out.push_back(loop[i]);
+      angle[static_cast<std::size_t>(loop[i])] = interior;
     }
   }
-  std::sort(out.begin(), out.end());
+  return angle;
+}
+
+}  // namespace
+
+std::vector<int> inwardCorners(const mesh::SheetMesh& mesh, double minAngle) {
+  std::vector<int> out;
+  const std::vector<double> angle = interiorAngles(mesh);
+  for (std::size_t v = 0; v < angle.size(); ++v)
+    if (angle[v] > std::numbers::pi + minAngle) out.push_back(static_cast<int>(v));
   return out;
 }
 
@@ -75,15 +87,25 @@ std::vector<TearCandidate> tearCandidates(const mesh::SheetMesh& mesh, const std
       throw std::invalid_argument("tearCandidates: vertex " + std::to_string(v) + " out of range");
     kind.emplace(v, k);  // the first kind given wins
   };
+  // A convex corner of the outline (interior angle below 135 degrees) does
+  // not start a tear: the material around it is the least loaded, and a
+  // direction into the sheet from it runs along an edge.
+  const std::vector<double> angle = interiorAngles(mesh);
+  std::vector<char> convexCorner(mesh.vertexCount(), 0);
+  for (std::size_t v = 0; v < angle.size(); ++v)
+    convexCorner[v] = angle[v] >= 0.0 && angle[v] < 0.75 * std::numbers::pi ? 1 : 0;
   for (int v : tips) add(v, CandidateKind::Tip);
-  for (int v : junctions) add(v, CandidateKind::Junction);
+  for (int v : junctions)
+    if (v < 0 || static_cast<std::size_t>(v) >= mesh.vertexCount() ||
+        convexCorner[static_cast<std::size_t>(v)] == 0)
+      add(v, CandidateKind::Junction);
   for (const auto& loop : boundaryLoops(mesh)) {
     const std::size_t n = loop.size();
     for (std::size_t i = 0; i < n; ++i) {
       const auto v = static_cast<std::size_t>(loop[i]);
       const auto before = static_cast<std::size_t>(loop[(i + n - 1) % n]);
       const auto after = static_cast<std::size_t>(loop[(i + 1) % n]);
-      if (held[v] == 0 && (held[before] != 0 || held[after] != 0))
+      if (held[v] == 0 && convexCorner[v] == 0 && (held[before] != 0 || held[after] != 0))
         add(loop[i], CandidateKind::HandleBorder);
     }
   }

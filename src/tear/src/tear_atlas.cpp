@@ -11,6 +11,7 @@
 #include <string>
 #include <utility>
 
+#include "crumple/core/geometry2d.hpp"
 #include "crumple/tear/lip_masks.hpp"
 
 namespace crumple::tear {
@@ -26,13 +27,6 @@ double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(
 
 long long floorDiv(long long a, long long b) {
   return a / b - ((a % b != 0) && ((a < 0) != (b < 0)));
-}
-
-double distanceToSegment(const Vec2& q, const Vec2& a, const Vec2& b) {
-  const Vec2 ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double t = len2 > 0.0 ? std::clamp((q - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (q - (a + t * ab)).norm();
 }
 
 // The point of a polyline nearest q: its distance and arc-length parameter.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "crumple/tear/candidates.hpp"
@@ -130,71 +131,114 @@ TearFrameResult Tearing::step(mesh::SheetMesh& mesh, const std::vector<int>& jun
 
   for (const Advance& a : advances) {
     const CandidateTest& t = *a.test;
-    const int vertex = t.candidate.vertex;
-    const Vec2 from = mesh.pattern[static_cast<std::size_t>(vertex)];
+    const Vec2 from = mesh.pattern[static_cast<std::size_t>(t.candidate.vertex)];
     // s_{t+1} = s_t + V E_r d_prop (thesis 3.3.3), the step held to what the mesh can show.
     const double length =
         std::clamp(params_.griffith.speed * t.propagation.energyRelease,
                    params_.minAdvance * edgeLength_, params_.maxAdvance * edgeLength_);
-    const Vec2 to = from + length * t.propagation.direction;
-    mesh::SheetMesh trial = mesh;
-    CutResult cut;
-    try {
-      CutOptions options;
-      options.snap = params_.snap;
-      options.fixed = &held;
-      cut = cutAlong(trial, vertex, to, options);
-    } catch (const std::invalid_argument&) {
-      continue;  // the direction leaves the sheet here: no tear from this point
-    }
-    if (cut.chain.size() < 2) continue;
-    mesh = std::move(trial);
-    lip_.resize(mesh.vertexCount(), 0);
-    for (int v : cut.chain) lip_[static_cast<std::size_t>(v)] = 1;
-    for (int v : cut.twins) lip_[static_cast<std::size_t>(v)] = 1;
-    // Moved vertices first: appended ones' blends may name them.
-    std::vector<std::pair<int, VertexBlend>> moved;
-    for (const auto& [v, b] : cut.relocated)
-      moved.emplace_back(v, resolve(b, result.vertexCountBefore, result.blends, result.relocated));
-    for (const VertexBlend& b : cut.blends)
-      result.blends.push_back(
-          resolve(b, result.vertexCountBefore, result.blends, result.relocated));
-    for (const auto& [v, b] : moved) {
-      if (static_cast<std::size_t>(v) >= result.vertexCountBefore) {
-        result.blends[static_cast<std::size_t>(v) - result.vertexCountBefore] = b;
-        continue;
-      }
-      const auto it = std::find_if(result.relocated.begin(), result.relocated.end(),
-                                   [&](const auto& m) { return m.first == v; });
-      if (it != result.relocated.end()) {
-        it->second = b;
-      } else {
-        result.relocated.emplace_back(v, b);
-      }
-    }
-
     TearEvent e;
-    e.started = a.tear < 0;
-    e.tear = e.started ? static_cast<int>(tips_.size()) : a.tear;
-    if (e.started) {
-      tips_.push_back(-1);
-      startKinds_.push_back(t.candidate.kind);
-    }
-    tips_[static_cast<std::size_t>(e.tear)] = cut.separated ? -1 : cut.tip;
+    e.tear = a.tear;
     e.kind = t.candidate.kind;
-    e.vertex = vertex;
     e.energyRelease = t.propagation.energyRelease;
     e.fractureEnergy = t.fractureEnergy;
-    e.from = from;
-    e.to = mesh.pattern[static_cast<std::size_t>(cut.chain.back())];
-    e.separated = cut.separated;
-    result.events.push_back(e);
+    (void)cutTo(mesh, t.candidate.vertex, from + length * t.propagation.direction, e, held, result);
+  }
+  return result;
+}
 
-    TearSegment s;
-    s.tear = e.tear;
-    for (int v : cut.chain) s.cut.push_back(mesh.pattern[static_cast<std::size_t>(v)]);
-    s.detail = detailPath(fibers_, e.from, e.to, params_.detail);
-    segments_.push_back(std::move(s));
+bool Tearing::cutTo(mesh::SheetMesh& mesh, int vertex, const Vec2& to, TearEvent e,
+                    const std::vector<char>& held, TearFrameResult& result) {
+  mesh::SheetMesh trial = mesh;
+  CutResult cut;
+  try {
+    CutOptions options;
+    options.snap = params_.snap;
+    options.fixed = &held;
+    cut = cutAlong(trial, vertex, to, options);
+  } catch (const std::invalid_argument&) {
+    return false;  // the direction leaves the sheet here: no tear from this point
+  }
+  if (cut.chain.size() < 2) return false;
+  mesh = std::move(trial);
+  lip_.resize(mesh.vertexCount(), 0);
+  for (int v : cut.chain) lip_[static_cast<std::size_t>(v)] = 1;
+  for (int v : cut.twins) lip_[static_cast<std::size_t>(v)] = 1;
+  // Moved vertices first: appended ones' blends may name them.
+  std::vector<std::pair<int, VertexBlend>> moved;
+  for (const auto& [v, b] : cut.relocated)
+    moved.emplace_back(v, resolve(b, result.vertexCountBefore, result.blends, result.relocated));
+  for (const VertexBlend& b : cut.blends)
+    result.blends.push_back(resolve(b, result.vertexCountBefore, result.blends, result.relocated));
+  for (const auto& [v, b] : moved) {
+    if (static_cast<std::size_t>(v) >= result.vertexCountBefore) {
+      result.blends[static_cast<std::size_t>(v) - result.vertexCountBefore] = b;
+      continue;
+    }
+    const auto it = std::find_if(result.relocated.begin(), result.relocated.end(),
+                                 [&](const auto& m) { return m.first == v; });
+    if (it != result.relocated.end()) {
+      it->second = b;
+    } else {
+      result.relocated.emplace_back(v, b);
+    }
+  }
+  e.started = e.tear < 0;
+  if (e.started) {
+    e.tear = static_cast<int>(tips_.size());
+    tips_.push_back(-1);
+    startKinds_.push_back(e.kind);
+  }
+  tips_[static_cast<std::size_t>(e.tear)] = cut.separated ? -1 : cut.tip;
+  e.vertex = vertex;
+  e.from = mesh.pattern[static_cast<std::size_t>(cut.chain.front())];
+  e.to = mesh.pattern[static_cast<std::size_t>(cut.chain.back())];
+  e.separated = cut.separated;
+  result.events.push_back(e);
+  TearSegment seg;
+  seg.tear = e.tear;
+  for (int v : cut.chain) seg.cut.push_back(mesh.pattern[static_cast<std::size_t>(v)]);
+  seg.detail = detailPath(fibers_, e.from, e.to, params_.detail);
+  segments_.push_back(std::move(seg));
+  return true;
+}
+
+TearFrameResult Tearing::replay(mesh::SheetMesh& mesh, const std::vector<TearEvent>& events,
+                                const std::vector<char>& held) {
+  if (!tips_.empty())
+    throw std::logic_error("Tearing::replay: only a Tearing without tears replays");
+  TearFrameResult result;
+  result.vertexCountBefore = mesh.vertexCount();
+  std::vector<int> tearOf;  // events' tear ids -> this Tearing's
+  for (TearEvent e : events) {
+    int vertex = -1;
+    const int original = e.tear;
+    if (e.started) {
+      // The boundary vertex nearest where the tear started.
+      double best = std::numeric_limits<double>::infinity();
+      for (const auto& loop : boundaryLoops(mesh))
+        for (int v : loop) {
+          const double d = (mesh.pattern[static_cast<std::size_t>(v)] - e.from).squaredNorm();
+          if (d < best) {
+            best = d;
+            vertex = v;
+          }
+        }
+      e.tear = -1;
+    } else {
+      if (original < 0 || static_cast<std::size_t>(original) >= tearOf.size() ||
+          tearOf[static_cast<std::size_t>(original)] < 0)
+        continue;
+      e.tear = tearOf[static_cast<std::size_t>(original)];
+      vertex = tips_[static_cast<std::size_t>(e.tear)];
+      if (vertex < 0) continue;
+    }
+    const std::size_t before = tips_.size();
+    const bool made = cutTo(mesh, vertex, e.to, e, held, result);
+    if (e.started) {
+      if (tearOf.size() <= static_cast<std::size_t>(original))
+        tearOf.resize(static_cast<std::size_t>(original) + 1, -1);
+      tearOf[static_cast<std::size_t>(original)] = made ? static_cast<int>(before) : -1;
+    }
   }
   return result;
 }

@@ -52,6 +52,11 @@ class HandleRig {
   // again on the new mesh at time t, their offsets measured from where they
   // are now in the node's frame at t, so the pins move on continuously.
   void rebindTangents(const mesh::SheetMesh& sheet, double t);
+  // The sheet was replaced by another mesh of the same pattern (a torn
+  // crumpling-model sheet handed over to the elastic model): handle h holds
+  // vertex handleVertices[h] of `sheet` from now on, and the tangent-plane
+  // vertices are chosen again as by rebindTangents.
+  void rebind(const mesh::SheetMesh& sheet, const std::vector<int>& handleVertices, double t);
   // Moves pinned vertices onto their targets (called once before simulation).
   void snap(double t, std::vector<Vec3>& positions) const;
 

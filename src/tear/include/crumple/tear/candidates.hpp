@@ -32,7 +32,9 @@ std::vector<std::vector<int>> boundaryLoops(const mesh::SheetMesh& mesh);
 std::vector<int> inwardCorners(const mesh::SheetMesh& mesh, double minAngle);
 
 // The candidates of a frame, sorted by vertex, one per vertex (the first
-// kind in the order Tip, Junction, HandleBorder, InwardCorner):
+// kind in the order Tip, Junction, HandleBorder, InwardCorner); junctions
+// and held areas' borders at a convex corner of the outline (interior angle
+// below 135 degrees) are not candidates:
 // `tips` and `junctions` as given (junctions from paper::junctionVertices);
 // boundary vertices that are not held but share an edge with a held one
 // (held[v] != 0: the handles' vertices and their tangent-plane vertices);

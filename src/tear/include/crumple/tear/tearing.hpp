@@ -73,6 +73,14 @@ class Tearing {
   TearFrameResult step(mesh::SheetMesh& mesh, const std::vector<int>& junctions,
                        const std::vector<char>& held, const VertexForces& forces);
 
+  // Makes the given advances (another Tearing's, on another mesh of the
+  // same pattern) again on `mesh`: a started tear from the boundary vertex
+  // nearest its start, each advance to its s_{t+1}. What a sheet handed
+  // over to a finer mesh keeps of its tears. Only on a Tearing without
+  // tears (std::logic_error otherwise).
+  TearFrameResult replay(mesh::SheetMesh& mesh, const std::vector<TearEvent>& events,
+                         const std::vector<char>& held);
+
   // Every advance so far, in order.
   const std::vector<TearSegment>& segments() const { return segments_; }
   // The tip vertex of each tear, -1 once it has torn through to the boundary.
@@ -83,6 +91,11 @@ class Tearing {
   double edgeLength() const { return edgeLength_; }
 
  private:
+  // Cuts `mesh` from `vertex` to `to` as event `e` (e.tear < 0: a new
+  // tear) and records it in `result`; false when the cut cannot be made.
+  bool cutTo(mesh::SheetMesh& mesh, int vertex, const Vec2& to, TearEvent e,
+             const std::vector<char>& held, TearFrameResult& result);
+
   TearingParams params_;
   FiberTexture fibers_;
   double edgeLength_ = 0.0;
