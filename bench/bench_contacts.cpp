@@ -52,24 +52,14 @@ int main(int argc, char** argv) {
   const fs::path scratch = fs::temp_directory_path() / "crumple-bench-contacts";
   std::vector<Row> rows;
   for (const std::string& name : samples) {
-    const io::SceneSpec scene =
-        io::loadScene(io::resolveScenePath(std::string(CRUMPLE_SOURCE_DIR) + "/samples/" + name));
+    const io::SceneSpec scene = bench::sampleScene(name);
     std::vector<double> step, collider, self, share, check;
     Row row;
     row.sample = name;
     for (int r = 0; r < runs; ++r) {
-      pipeline::ShotOptions options;
-      options.outDir = (scratch / name).string();
-      options.render = false;
-      options.log = std::fopen("/dev/null", "w");
-      options.interactive = 0;
-      const pipeline::ShotReport report = pipeline::runShot(scene, options);
-      std::fclose(options.log);
+      const pipeline::ShotReport report = bench::simulateQuietly(scene, (scratch / name).string());
       const double frames = std::max(1, report.framesSimulated - 1);
-      double stepTotal = 0.0;
-      for (const char* s : {"elastic", "geometric", "cones", "rebuild", "isometry", "contacts"})
-        if (const auto it = report.stages.find(s); it != report.stages.end())
-          stepTotal += it->second.totalMs;
+      const double stepTotal = bench::stepTotalMs(report);
       step.push_back(stepTotal / frames);
       collider.push_back(report.contactMs / frames);
       self.push_back(report.selfContactMs / frames);

@@ -2,9 +2,13 @@
 // What the whole-shot benchmarks (bench_contacts, bench_tear) share: their
 // command line `[SAMPLE ...] [--runs 3] [--json FILE]` and the median.
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 #include <vector>
+
+#include "crumple/io/scene.hpp"
+#include "crumple/pipeline/shot.hpp"
 
 namespace crumple::bench {
 
@@ -36,6 +40,33 @@ inline double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// The sample's scene (samples/NAME under the source tree).
+inline io::SceneSpec sampleScene(const std::string& name) {
+  return io::loadScene(io::resolveScenePath(std::string(CRUMPLE_SOURCE_DIR) + "/samples/" + name));
+}
+
+// One quiet simulation of `scene` into `outDir`, without rendering.
+inline pipeline::ShotReport simulateQuietly(const io::SceneSpec& scene, const std::string& outDir) {
+  pipeline::ShotOptions options;
+  options.outDir = outDir;
+  options.render = false;
+  options.log = std::fopen("/dev/null", "w");
+  options.interactive = 0;
+  pipeline::ShotReport report = pipeline::runShot(scene, options);
+  std::fclose(options.log);
+  return report;
+}
+
+// The simulation step's total wall time (ms): the elastic model's and the
+// crumpling model's stages and contacts.
+inline double stepTotalMs(const pipeline::ShotReport& report) {
+  double total = 0.0;
+  for (const char* s : {"elastic", "geometric", "cones", "rebuild", "isometry", "contacts"})
+    if (const auto it = report.stages.find(s); it != report.stages.end())
+      total += it->second.totalMs;
+  return total;
 }
 
 }  // namespace crumple::bench
