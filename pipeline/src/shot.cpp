@@ -175,6 +175,7 @@ tear::TearingParams tearingParamsOf(const io::TearSpec& t) {
   p.detail.blend = t.detailBlend;
   p.detail.stressWidth = t.stressWidth;
   p.maxNewTearsPerFrame = t.maxNewPerFrame;
+  p.branchAngle = t.epsA;
   return p;
 }
 

@@ -17,6 +17,7 @@
 #include "crumple/tear/griffith.hpp"
 #include "crumple/tear/lip_masks.hpp"
 #include "crumple/tear/tear_step.hpp"
+#include "crumple/tear/tearing.hpp"
 #include "crumple/tear/tip_pulls.hpp"
 
 namespace crumple::tear {
@@ -580,6 +581,59 @@ TEST(Cut, ATearGoesOnFromItsTipTurningEitherWay) {
     EXPECT_TRUE(m.pattern[static_cast<std::size_t>(second.tip)].isApprox(to, 1e-12)) << turn;
     EXPECT_EQ(boundaryLoops(m).size(), 1u);
   }
+}
+
+}  // namespace
+}  // namespace crumple::tear
+
+namespace crumple::tear {
+namespace {
+
+// The candidates of a Tearing whose one tear went from the bottom edge's
+// middle up 1 cm, then `turn` rad to the left for another cm (replayed),
+// with no forces anywhere.
+std::vector<TearCandidate> candidatesAfterATurn(double turn) {
+  mesh::SheetMesh m = mesh::makeRectangleSheet(0.04, 0.04, 0.005);
+  Tearing tearing(m, TearingParams{}, 1);
+  const std::vector<char> held(m.vertexCount(), 0);
+  TearEvent start;
+  start.started = true;
+  start.tear = 0;
+  start.kind = CandidateKind::InwardCorner;
+  start.from = Vec2(0.02, 0.0);
+  start.to = Vec2(0.02, 0.01);
+  TearEvent on = start;
+  on.started = false;
+  on.from = start.to;
+  on.to = start.to + 0.01 * Vec2(-std::sin(turn), std::cos(turn));
+  const TearFrameResult made = tearing.replay(m, {start, on}, held);
+  EXPECT_EQ(made.events.size(), 2u);
+  std::vector<char> none(m.vertexCount(), 0);
+  const TearFrameResult next =
+      tearing.step(m, {}, none, [](int) { return std::vector<TriangleForce>{}; });
+  std::vector<TearCandidate> out;
+  for (const auto& t : next.tests) out.push_back(t.candidate);
+  return out;
+}
+
+TEST(Tearing, ATearMayBranchWhereItTurnedMoreThanEpsA) {
+  // Straight on: the former tip is part of the lips, only the tip is a candidate.
+  const auto straight = candidatesAfterATurn(0.0);
+  ASSERT_EQ(straight.size(), 1u);
+  EXPECT_EQ(straight[0].kind, CandidateKind::Tip);
+  // A 0.5 rad turn (> eps_a = 0.1): the former tip's copy on the outside of
+  // the turn is an inward corner of the outline, a candidate to branch from.
+  const auto turned = candidatesAfterATurn(0.5);
+  ASSERT_EQ(turned.size(), 2u);
+  int tips = 0, corners = 0;
+  for (const auto& c : turned) {
+    tips += c.kind == CandidateKind::Tip ? 1 : 0;
+    corners += c.kind == CandidateKind::InwardCorner ? 1 : 0;
+  }
+  EXPECT_EQ(tips, 1);
+  EXPECT_EQ(corners, 1);
+  // Below eps_a (0.05 rad), no branch point.
+  EXPECT_EQ(candidatesAfterATurn(0.05).size(), 1u);
 }
 
 }  // namespace

@@ -759,6 +759,10 @@ class SceneParser {
       if (!(*v >= 0.0 && *v < 180.0)) r.fail("inward_angle_deg", "must be in [0, 180)");
       t.minInwardAngle = *v * std::numbers::pi / 180.0;
     }
+    if (auto v = r.number("eps_a")) {
+      if (!(*v >= 0.0 && *v < std::numbers::pi)) r.fail("eps_a", "must be in [0, pi) (rad)");
+      t.epsA = *v;
+    }
     if (auto v = r.integer("max_new_per_frame")) {
       if (*v < 0 || *v > 100) r.fail("max_new_per_frame", "must be in [0, 100]");
       t.maxNewPerFrame = static_cast<int>(*v);

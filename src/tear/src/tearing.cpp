@@ -83,6 +83,8 @@ Tearing::Tearing(const mesh::SheetMesh& mesh, const TearingParams& params, std::
   if (params.maxNewTearsPerFrame < 0)
     throw std::invalid_argument("Tearing: maxNewTearsPerFrame must be >= 0");
   if (!(edgeLength_ > 0.0)) throw std::invalid_argument("Tearing: a mesh without edges");
+  if (!(params.branchAngle >= 0.0))
+    throw std::invalid_argument("Tearing: branchAngle must be >= 0");
 }
 
 TearFrameResult Tearing::step(mesh::SheetMesh& mesh, const std::vector<int>& junctions,
@@ -163,6 +165,25 @@ bool Tearing::cutTo(mesh::SheetMesh& mesh, int vertex, const Vec2& to, TearEvent
   lip_.resize(mesh.vertexCount(), 0);
   for (int v : cut.chain) lip_[static_cast<std::size_t>(v)] = 1;
   for (int v : cut.twins) lip_[static_cast<std::size_t>(v)] = 1;
+  // Thesis Fig. 3.20: where the tear turns at s_t by more than eps_a, s_t is
+  // split into two boundary points, one of them an inward corner: a point
+  // the tear may branch from. Where it runs on straight, s_t is just part of
+  // the lips.
+  if (e.tear >= 0 && !cut.twins.empty()) {
+    const auto last = std::find_if(segments_.rbegin(), segments_.rend(),
+                                   [&](const TearSegment& seg) { return seg.tear == e.tear; });
+    if (last != segments_.rend() && last->cut.size() >= 2) {
+      const Vec2 before = last->cut.back() - last->cut.front();
+      const Vec2 after = mesh.pattern[static_cast<std::size_t>(cut.chain.back())] -
+                         mesh.pattern[static_cast<std::size_t>(cut.chain.front())];
+      const double turn =
+          std::atan2(std::abs(before.x() * after.y() - before.y() * after.x()), before.dot(after));
+      if (turn > params_.branchAngle) {
+        lip_[static_cast<std::size_t>(cut.chain.front())] = 0;
+        lip_[static_cast<std::size_t>(cut.twins.front())] = 0;
+      }
+    }
+  }
   // Moved vertices first: appended ones' blends may name them.
   std::vector<std::pair<int, VertexBlend>> moved;
   for (const auto& [v, b] : cut.relocated)

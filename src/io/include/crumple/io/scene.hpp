@@ -173,6 +173,7 @@ struct TearSpec {
   double stressWidth = 0.5e-3;  // m: G_t's standard deviation
   double minInwardAngle = 0.1;  // rad: inward corners sharper than pi + this are candidates
   int maxNewPerFrame = 1;       // tears that may start in one frame
+  double epsA = 0.1;  // rad: a tear turning more at a former tip may branch there (Fig. 3.20)
 };
 
 struct GroundSpec {

@@ -31,6 +31,11 @@ struct TearingParams {
   double maxAdvance = 2.0;
   double snap = 0.2;            // CutOptions::snap
   int maxNewTearsPerFrame = 1;  // the strongest candidates (E_r / E_f) start first
+  // eps_a (thesis 3.3.3, Fig. 3.20; rad): where a tear turns by more than
+  // this at a tip it leaves behind, that point stays a candidate (its lip's
+  // inward corner: the tear may branch there); elsewhere a tear's lips are
+  // not candidates.
+  double branchAngle = 0.1;
 };
 
 // One advance of one tear in a frame.
@@ -66,8 +71,8 @@ class Tearing {
   Tearing(const mesh::SheetMesh& mesh, const TearingParams& params, std::uint64_t seed);
 
   // Tests the frame's candidates (tips, `junctions`, borders of held areas
-  // with held[v] != 0, inward corners; not the vertices of a tear's lips but
-  // its tip) with the elastic step's `forces` and
+  // with held[v] != 0, inward corners; of a tear's lips only its tip and the
+  // former tips where it turned by more than branchAngle) with the elastic step's `forces` and
   // cuts `mesh` where E_r >= E_f. A cut that cannot be made (the direction
   // leaves the sheet at once) is skipped and the mesh left as it was.
   TearFrameResult step(mesh::SheetMesh& mesh, const std::vector<int>& junctions,
