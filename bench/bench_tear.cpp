@@ -80,23 +80,17 @@ int main(int argc, char** argv) {
   std::error_code ignored;
   fs::remove_all(scratch, ignored);
   if (!jsonPath.empty()) {
-    std::FILE* f = std::fopen(jsonPath.c_str(), "w");
-    if (f == nullptr) {
-      std::fprintf(stderr, "bench_tear: cannot write %s\n", jsonPath.c_str());
-      return 1;
+    std::vector<std::string> json;
+    for (const Row& r : rows) {
+      char text[512];
+      std::snprintf(text, sizeof text,
+                    "{\"sample\": \"%s\", \"frames\": %d, \"tip_advances\": %zu, "
+                    "\"step_ms_per_frame\": %.6g, \"tear_ms_per_frame\": %.6g, "
+                    "\"bake_ms_per_frame\": %.6g, \"share_of_step\": %.6g}",
+                    r.sample.c_str(), r.frames, r.advances, r.stepMs, r.tearMs, r.bakeMs, r.share);
+      json.emplace_back(text);
     }
-    std::fprintf(f, "{\"runs\": %d, \"samples\": [", runs);
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-      const Row& r = rows[i];
-      std::fprintf(f,
-                   "%s{\"sample\": \"%s\", \"frames\": %d, \"tip_advances\": %zu, "
-                   "\"step_ms_per_frame\": %.6g, \"tear_ms_per_frame\": %.6g, "
-                   "\"bake_ms_per_frame\": %.6g, \"share_of_step\": %.6g}",
-                   i == 0 ? "" : ", ", r.sample.c_str(), r.frames, r.advances, r.stepMs, r.tearMs,
-                   r.bakeMs, r.share);
-    }
-    std::fprintf(f, "]}\n");
-    std::fclose(f);
+    if (!bench::writeSampleRows(jsonPath, "bench_tear", runs, json)) return 1;
   }
   return 0;
 }

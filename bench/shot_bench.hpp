@@ -69,4 +69,20 @@ inline double stepTotalMs(const pipeline::ShotReport& report) {
   return total;
 }
 
+// Writes {"runs": N, "samples": [ROW, ...]} to `path` (each row a JSON
+// object's text). False, with a message naming `bench`, when it cannot.
+inline bool writeSampleRows(const std::string& path, const char* bench, int runs,
+                            const std::vector<std::string>& rows) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (f == nullptr) {
+    std::fprintf(stderr, "%s: cannot write %s\n", bench, path.c_str());
+    return false;
+  }
+  std::fprintf(f, "{\"runs\": %d, \"samples\": [", runs);
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    std::fprintf(f, "%s%s", i == 0 ? "" : ", ", rows[i].c_str());
+  std::fprintf(f, "]}\n");
+  return std::fclose(f) == 0;
+}
+
 }  // namespace crumple::bench
