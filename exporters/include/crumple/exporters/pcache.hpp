@@ -67,7 +67,7 @@ struct FrameRecord {
   std::vector<int> singularVertices;
   std::vector<int> junctionVertices;
   std::vector<std::array<int, 2>> rulings;
-  std::uint32_t tearCount = 0;
+  std::uint32_t tearCount = 0;  // tears started so far (issue 6)
   // Handles, in header.handleNames order: the constrained vertex and the
   // imported track's position at this frame's time.
   std::vector<int> handleVertices;
