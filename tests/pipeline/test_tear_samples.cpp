@@ -282,3 +282,25 @@ TEST(TearSamples, TheCrumplingModelTearsAtAJunctionAndGoesOnElastic) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(TearSamples, TearNotchIsByteIdenticalOnOneAndTwoThreads) {
+  // Frames 0-30 hold the first tear (frame 16) and four tip advances.
+  const TempDir dir;
+  std::string caches[2];
+  for (const int threads : {1, 2}) {
+    const std::string out = (dir / std::to_string(threads)).string();
+    const auto r = crumple::testing::runCrumple("simulate " + sourcePath("samples/tear-notch") +
+                                                " --frames 0-30 --threads " +
+                                                std::to_string(threads) + " --out " + out);
+    ASSERT_EQ(r.status, 0) << r.output;
+    caches[threads - 1] = crumple::testing::readFile(out + "/cache.pcache");
+    const cache::CacheReader reader(out + "/cache.pcache");
+    EXPECT_GT(reader.readFrame(reader.frameCount() - 1).tearCount, 0u) << "it tore";
+  }
+  EXPECT_FALSE(caches[0].empty());
+  EXPECT_TRUE(caches[0] == caches[1]) << "byte-identical on 1 and 2 threads";
+}
+
+}  // namespace
