@@ -11,6 +11,7 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <string_view>
 
@@ -182,6 +183,17 @@ tear::TearingParams tearingParamsOf(const io::TearSpec& t) {
 // A torn crumpling-model sheet handed over to the elastic model settles in
 // these tiny steps (s) before it moves on.
 constexpr int kRelaxSteps = 4;
+// The crumpling model's tears are slits of this width in S_G's pattern
+// (paper::GeometricCutOptions::kerf); their lips are within a few kerfs of
+// the tear's cut (the copies of a tip where it turned, a tear's first
+// copies on the outline).
+constexpr double kTearKerf = 1e-5;
+constexpr double kLipTolerance = 12.0 * kTearKerf;
+// The crumpling model's tears start at least this far (rad) from the
+// outline's direction (tear::TearingParams::minStartAngle): cylinder-fold
+// with [tear] started one at 17 degrees along its bottom edge, 0.66 mm in,
+// and S_P's sliver triangles there failed the elastic step four frames on.
+constexpr double kMinStartAngle = 25.0 * std::numbers::pi / 180.0;
 constexpr double kRelaxDt = 1e-4;
 
 // The crumpling model's sheet at the elastic model's resolution (a torn
@@ -433,7 +445,15 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   // Tearing (issue 6): runs only when the scene enables it.
   std::optional<tear::Tearing> tearing;
   if (scene.tear.enabled) {
-    tearing.emplace(sheet, tearingParamsOf(scene.tear), seed);
+    tear::TearingParams tearParams = tearingParamsOf(scene.tear);
+    // The crumpling model's cuts are S_G's (paper::cutGeometricMesh), S_P
+    // only finds where they go: over S_P's long curved-region cells the
+    // elastic model's snap would pull short advances back onto the tip.
+    if (hybrid) {
+      tearParams.snap = paper::GeometricCutOptions{}.snap;
+      tearParams.minStartAngle = kMinStartAngle;
+    }
+    tearing.emplace(sheet, tearParams, seed);
     report.tearingOn = true;
   }
 
@@ -476,6 +496,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   // The baked tear textures (TEAR block) of the current mesh, re-baked when a
   // tear advances (thesis 3.3.4).
   std::optional<cache::ExtensionBlock> tearAtlasBlock;
+  mesh::SheetMesh bakedSheet;  // the triangles and pattern tearAtlasBlock refers to
   auto emit = [&](int frame) {
     const double t = frameTime(scene, frame);
     record.frame = frame;
@@ -585,6 +606,12 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     if (hybrid) {
       sheet = hybrid->physical().mesh;
       junctions = paper::junctionVertices(hybrid->geometric());  // S_G vertices are S_P's first
+      // S_P was rebuilt by the frame's animation steps: its tips and lips again.
+      try {
+        tearing->rebind(sheet, kLipTolerance);
+      } catch (const std::exception& e) {
+        throw NumericalError("tear", frame, e.what());
+      }
     }
     sheet.positions = model.positions();
     std::vector<char> held(sheet.vertexCount(), 0);
@@ -616,14 +643,68 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
                      t.propagation.direction.x(), t.propagation.direction.y(),
                      t.tears ? " tears" : "");
       }
+    if (const char* trace = std::getenv("CRUMPLE_DEBUG_TEAR"); trace != nullptr && trace[0] == '1')
+      for (const auto& why : r.skipped)
+        std::fprintf(stderr, "tear: frame %d not cut: %s\n", frame, why.c_str());
     if (r.changed()) {
       std::vector<tear::TearEvent> events = r.events;
       carriedContacts = hybrid ? hybrid->contacts() : model.contacts();
-      if (hybrid) {
-        // The geometric layer cannot be cut (docs/TEARING.md): from its first
-        // tear on, the sheet goes on as the elastic model on the scene's
-        // rectangle mesh, placed and moving as S_P, its tears made again on
-        // it, its handles on the vertices nearest their points.
+      // The crumpling model: the advances cut S_G (thesis 3.3.3 "Remeshing"),
+      // S_P is rebuilt from it, and the model goes on with the torn sheet.
+      bool cutInGeometric = false;
+      if (hybrid && std::none_of(r.events.begin(), r.events.end(),
+                                 [](const tear::TearEvent& e) { return e.separated; })) {
+        const auto& segments = tearing->segments();
+        const std::size_t first = segments.size() - r.events.size();
+        std::vector<paper::HybridSheet::TearAdvance> advances;
+        for (std::size_t k = 0; k < r.events.size(); ++k) {
+          paper::HybridSheet::TearAdvance a;
+          a.from = r.events[k].from;
+          a.to = r.events[k].to;
+          for (std::size_t j = first + k; !r.events[k].started && j-- > 0;)
+            if (segments[j].tear == r.events[k].tear) {
+              a.previousDirection = (segments[j].cut.back() - segments[j].cut.front()).normalized();
+              break;
+            }
+          advances.push_back(a);
+        }
+        std::string why = "it would come apart in pieces";
+        try {
+          paper::GeometricCutOptions cutOptions;
+          cutOptions.kerf = kTearKerf;
+          if (const auto cuts = hybrid->tear(advances, cutOptions)) {
+            std::vector<std::vector<Vec2>> lines;
+            for (const auto& c : *cuts) {
+              lines.push_back(c.cut);
+              report.tearRegionsFlattened += c.regionsFlattened;
+            }
+            tearing->recut(lines);
+            sheet = hybrid->physical().mesh;
+            tearing->rebind(sheet, kLipTolerance);
+            for (std::size_t k = 0; k < events.size(); ++k) {
+              events[k].from = lines[k].front();
+              events[k].to = lines[k].back();
+            }
+            report.tearGeometricCuts += static_cast<int>(cuts->size());
+            cutInGeometric = true;
+          }
+        } catch (const std::exception& e) {
+          why = e.what();
+        }
+        if (!cutInGeometric)
+          report.notes.push_back("frame " + std::to_string(frame) +
+                                 ": the crumpling model's geometric layer could not take the "
+                                 "tear (" +
+                                 why + ")");
+      }
+      if (hybrid && !cutInGeometric) {
+        // S_G is one piece with one outline (docs/TEARING.md): a sheet torn
+        // apart goes on as the elastic model on the scene's rectangle mesh,
+        // placed and moving as S_P, all its tears made again on it, its
+        // handles on the vertices nearest their points.
+        std::vector<tear::TearEvent> all;
+        for (const auto& a : report.tearAdvances) all.push_back(a.event);
+        all.insert(all.end(), r.events.begin(), r.events.end());
         std::vector<int> spHandles;
         for (const auto& h : rig.handles()) spHandles.push_back(h.vertex);
         const mesh::SheetMesh& sp = hybrid->physical().mesh;
@@ -636,13 +717,18 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
           freshTearing.emplace(resampled->mesh, tearingParamsOf(scene.tear), seed);
           std::vector<char> fineHeld(resampled->mesh.vertexCount(), 0);
           for (int v : resampled->handleVertices) fineHeld[static_cast<std::size_t>(v)] = 1;
-          replayed = freshTearing->replay(resampled->mesh, r.events, fineHeld);
+          replayed = freshTearing->replay(resampled->mesh, all, fineHeld);
         } catch (const std::exception& e) {
           throw NumericalError("tear handover", frame, e.what());
         }
         ResampledSheet& fine = *resampled;
         tear::Tearing& fresh = *freshTearing;
-        events = replayed.events;
+        // This frame's advances as the fine mesh took them (the earlier
+        // ones are in the report already).
+        events.assign(replayed.events.end() -
+                          std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(r.events.size()),
+                                                   std::ssize(replayed.events)),
+                      replayed.events.end());
         sheet = std::move(fine.mesh);
         const std::vector<Vec3> velocities =
             tear::blendValues(fine.velocities, replayed.blends, replayed.relocated);
@@ -667,11 +753,10 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
         hybrid.reset();
         report.tearHandoverFrame = frame;
         report.vertices = sheet.vertexCount();
-        report.notes.push_back("the sheet tore at frame " + std::to_string(frame) +
-                               ": from there on it is simulated by the elastic model on the "
-                               "scene's rectangle mesh (the crumpling model's geometric layer is "
-                               "not cut)");
-      } else {
+        report.notes.push_back("frame " + std::to_string(frame) +
+                               ": from there on the sheet is simulated by the elastic model on "
+                               "the scene's rectangle mesh");
+      } else if (!hybrid) {
         // The elastic model on the cut mesh: velocities carried over the cut,
         // each uncut hinge's rest angle and stiffness factor kept.
         const std::vector<Vec3> velocities =
@@ -695,15 +780,23 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
         report.tearAdvances.push_back({frame, e});
         if (report.firstTearFrame < 0) report.firstTearFrame = frame;
       }
+    }
+    // The tear textures, baked again whenever the mesh they refer to changed:
+    // after a cut, and every frame the crumpling model rebuilt S_P.
+    if (!tearing->segments().empty() && (r.changed() || sheet.triangles != bakedSheet.triangles ||
+                                         sheet.pattern != bakedSheet.pattern)) {
       const auto bakeStart = Clock::now();
       tear::TearAtlasParams atlas;
       atlas.texelSize = tearing->fibers().texelSize();
+      atlas.lipTolerance = hybrid ? kLipTolerance : 0.0;
       try {
         tearAtlasBlock =
             cache::encodeTearAtlas(tear::bakeTearAtlas(sheet, tearing->segments(), atlas));
       } catch (const std::exception& e) {
         throw NumericalError("tear atlas", frame, e.what());
       }
+      bakedSheet.triangles = sheet.triangles;
+      bakedSheet.pattern = sheet.pattern;
       report.tearBakeMs += msSince(bakeStart);
     }
     report.tearMs += msSince(start);
@@ -972,6 +1065,8 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
     j.key("bake_ms_per_frame").value(r.tearBakeMs / frames);
     j.key("first_tear_frame").value(r.firstTearFrame);
     j.key("tip_advances").value(static_cast<long long>(r.tearAdvances.size()));
+    j.key("crumpling_model_cuts").value(r.tearGeometricCuts);
+    j.key("curved_regions_flattened").value(r.tearRegionsFlattened);
     j.key("handover_frame").value(r.tearHandoverFrame);
     j.key("tears").beginArray();
     for (std::size_t t = 0; t < r.tearStartKinds.size(); ++t) {

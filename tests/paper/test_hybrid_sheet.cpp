@@ -123,3 +123,46 @@ TEST(HybridSheet, Deterministic) {
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i], b[i]);
 }
+
+// Issue 6: a tear cuts S_G (HybridSheet::tear) and the model goes on with
+// the torn sheet. The two bottom corners are drawn apart: S_G stays valid
+// at every sub-step (checkInvariants), the lips at the slit's mouth open in
+// 3D, and the tip stays an S_G vertex on the outline.
+TEST(HybridSheet, ATornSheetGoesOnAndItsLipsOpen) {
+  const std::vector<Vec2> corners{Vec2(0, 0), Vec2(kL, 0), Vec2(kL, kL), Vec2(0, kL)};
+  InitialSheet sheet = makeFlatSheet(kL, kL, corners, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
+  HybridSheet hybrid(sheet.mesh, sim::Material{}, weightless(), checked(), 1);
+  HybridSheet::TearAdvance advance;
+  advance.from = Vec2(0.5 * kL, 0.0);
+  advance.to = Vec2(0.5 * kL, 0.4 * kL);
+  const auto cuts = hybrid.tear({advance}, GeometricCutOptions{});
+  ASSERT_TRUE(cuts.has_value());
+  ASSERT_EQ(cuts->size(), 1u);
+  EXPECT_EQ(validate(hybrid.geometric()), "");
+  const auto pins = [&](double t, std::vector<sim::Pin>& out) {
+    out.clear();
+    for (std::size_t k = 0; k < sheet.handleVertices.size(); ++k) {
+      const int v = sheet.handleVertices[k];
+      Vec3 x = sheet.mesh.vertices[static_cast<std::size_t>(v)].position;
+      if (k < 2) x.x() += (k == 0 ? -1.0 : 1.0) * 0.2 * kL * std::min(1.0, t / 0.2);
+      out.push_back({v, x});
+    }
+  };
+  for (int f = 0; f < 6; ++f) hybrid.advance(f / 24.0, 1.0 / 24.0, 2, pins, f + 1);
+  const GeometricMesh& g = hybrid.geometric();
+  EXPECT_EQ(validate(g), "");
+  // The mouth's two copies: the outline vertices nearest the tear's start.
+  double opening = 0.0;
+  for (const GeometricVertex& a : g.vertices)
+    for (const GeometricVertex& b : g.vertices)
+      if (a.onBoundary && b.onBoundary && (a.pattern - advance.from).norm() < 1e-3 &&
+          (b.pattern - advance.from).norm() < 1e-3)
+        opening = std::max(opening, (a.position - b.position).norm());
+  EXPECT_GT(opening, 0.1 * kL) << "the lips part as the corners are drawn apart";
+  bool tipOnOutline = false;
+  for (const GeometricVertex& v : g.vertices)
+    tipOnOutline =
+        tipOnOutline || (v.onBoundary && v.corner && (v.pattern - advance.to).norm() < 1e-12);
+  EXPECT_TRUE(tipOnOutline);
+  EXPECT_EQ(mesh::validate(hybrid.physical().mesh), "");
+}

@@ -78,15 +78,19 @@ double lipOpening(const TearShot& shot) {
   m.regionTypes = {mesh::RegionType::Flat};
   EXPECT_EQ(mesh::validate(m), "");
   EXPECT_NO_THROW((void)tear::boundaryLoops(m)) << "the outline and the lips are simple loops";
-  std::map<std::pair<double, double>, std::vector<int>> byPattern;
-  for (std::size_t v = 0; v < m.pattern.size(); ++v)
-    byPattern[{m.pattern[v].x(), m.pattern[v].y()}].push_back(static_cast<int>(v));
+  // Twins: boundary vertices at one pattern point (the elastic model's cuts)
+  // or across the crumpling model's slit (a few kerfs of 10 um apart).
+  std::vector<int> boundary;
+  for (const auto& loop : tear::boundaryLoops(m))
+    boundary.insert(boundary.end(), loop.begin(), loop.end());
   double opening = 0.0;
-  for (const auto& [p, vs] : byPattern)
-    for (std::size_t i = 1; i < vs.size(); ++i)
-      opening = std::max(opening, (m.positions[static_cast<std::size_t>(vs[i])] -
-                                   m.positions[static_cast<std::size_t>(vs[0])])
-                                      .norm());
+  for (std::size_t i = 0; i < boundary.size(); ++i)
+    for (std::size_t j = i + 1; j < boundary.size(); ++j) {
+      const auto a = static_cast<std::size_t>(boundary[i]),
+                 b = static_cast<std::size_t>(boundary[j]);
+      if ((m.pattern[a] - m.pattern[b]).norm() <= 1.2e-4)
+        opening = std::max(opening, (m.positions[a] - m.positions[b]).norm());
+    }
   return opening;
 }
 
@@ -221,41 +225,49 @@ TEST(TearSamples, ASceneWithoutTearNeverTears) {
 namespace {
 
 TEST(TearSamples, TearCylinderStartsAtAJunctionPoint) {
-  // Thesis Fig. 3.26: the crumpling model's half tube tears at a junction
-  // point between its curved region and a flat one, then goes on as the
-  // elastic model (docs/TEARING.md).
+  // Thesis Fig. 3.26: flattening one border of the crumpling model's half
+  // tube tears it at a junction point between its curved region and a flat
+  // one; the tear cuts S_G and the crumpling model goes on with the torn
+  // sheet (docs/TEARING.md "The crumpling model torn").
   const TempDir dir;
   const TearShot shot = runTearSample("tear-cylinder", dir);
   const auto& r = shot.report;
   EXPECT_EQ(r.error, "");
   ASSERT_FALSE(r.tearStartKinds.empty());
   EXPECT_EQ(r.tearStartKinds[0], tear::CandidateKind::Junction);
-  EXPECT_EQ(r.tearHandoverFrame, r.firstTearFrame);
+  EXPECT_GE(r.firstTearFrame, 36) << "the flattening (from 1.5 s) tears it, not the wrap";
+  EXPECT_GE(r.tearGeometricCuts, 3) << "the tear advances in S_G";
+  const int crumplingUntil = r.tearHandoverFrame >= 0 ? r.tearHandoverFrame : 1 << 30;
+  EXPECT_GT(crumplingUntil, r.firstTearFrame + 2) << "the crumpling model goes on torn";
   const double opening = lipOpening(shot);
-  // c_mean before and after the tear: the crumpling model's own (reported:
-  // it is issue 3's), and the torn sheet's (the issue's 0.5 %).
+  // c_mean before the tear, of the torn crumpling model, and after a hand-over.
   const cache::CacheReader reader(r.cachePath);
-  double before = 0.0, after = 0.0;
+  double before = 0.0, torn = 0.0, elastic = 0.0;
   for (std::size_t k = 0; k < reader.frameCount(); ++k) {
     const auto f = reader.readFrame(k);
-    double& worst = f.frame >= r.firstTearFrame ? after : before;
+    double& worst = f.frame < r.firstTearFrame ? before : f.frame < crumplingUntil ? torn : elastic;
     worst = std::max(worst, pipeline::measureFrame(f).cMean);
   }
   std::printf(
       "[ measure ] tear-cylinder: %zu tear(s) (the first from a junction at frame %d), "
-      "%zu advances; lips %.2f mm apart; c_mean at most %.3f %% before the tear, %.3f %% "
-      "after; detail path %.3f x the tips' segments\n",
-      r.tearStartKinds.size(), r.firstTearFrame, r.tearAdvances.size(), 1e3 * opening,
-      100.0 * before, 100.0 * after, detailRatio(r));
+      "%zu advances, %d of them in S_G (%d curved regions flattened), hand-over at frame %d; "
+      "lips %.2f mm apart; c_mean at most %.3f %% before the tear, %.3f %% torn in the "
+      "crumpling model, %.3f %% after the hand-over; detail path %.3f x the tips' segments\n",
+      r.tearStartKinds.size(), r.firstTearFrame, r.tearAdvances.size(), r.tearGeometricCuts,
+      r.tearRegionsFlattened, r.tearHandoverFrame, 1e3 * opening, 100.0 * before, 100.0 * torn,
+      100.0 * elastic, detailRatio(r));
   EXPECT_GT(opening, 2e-3);
   EXPECT_GE(detailRatio(r), 1.15);
-  EXPECT_LE(after, 0.005);
+  // The untorn crumpling model itself reaches 3.2 % in this shot (the
+  // fingers stretch the flattened border; issue 3): a bound against blow-up.
+  EXPECT_LE(torn, 0.04);
 }
 
-TEST(TearSamples, TheCrumplingModelTearsAtAJunctionAndGoesOnElastic) {
+TEST(TearSamples, TheCrumplingModelTearsAtAJunctionAndGoesOnCrumpling) {
   // cylinder-fold with [tear]: as its tube bends, the sheet tears at a
-  // junction point of S_G (thesis 3.3.2) and goes on as the elastic model
-  // on the scene's rectangle mesh to the end.
+  // junction point of S_G (thesis 3.3.2); the tear cuts S_G and the
+  // crumpling model runs on to the end with the torn sheet: its frames keep
+  // rulings and junction points, and the rulings keep changing.
   const TempDir dir;
   io::SceneSpec scene = io::loadScene(io::resolveScenePath(sourcePath("samples/cylinder-fold")));
   scene.tear.enabled = true;
@@ -264,20 +276,32 @@ TEST(TearSamples, TheCrumplingModelTearsAtAJunctionAndGoesOnElastic) {
   ASSERT_FALSE(r.tearStartKinds.empty());
   EXPECT_EQ(r.tearStartKinds[0], tear::CandidateKind::Junction);
   EXPECT_GT(r.firstTearFrame, 0);
-  EXPECT_EQ(r.tearHandoverFrame, r.firstTearFrame);
+  EXPECT_EQ(r.tearHandoverFrame, -1) << "the torn sheet stays the crumpling model's";
+  EXPECT_EQ(r.tearGeometricCuts, static_cast<int>(r.tearAdvances.size()));
   const cache::CacheReader reader(r.cachePath);
   double torn = 0.0;  // c_mean over the frames after the tear
+  int tornFrames = 0, withRulings = 0, rulingChanges = 0;
+  std::vector<std::array<int, 2>> lastRulings;
   for (std::size_t k = 0; k < reader.frameCount(); ++k) {
     const auto f = reader.readFrame(k);
     EXPECT_EQ(cache::decodeTearAtlas(f.extensions).has_value(), f.frame >= r.firstTearFrame)
         << "frame " << f.frame;
-    if (f.frame >= r.firstTearFrame) torn = std::max(torn, pipeline::measureFrame(f).cMean);
+    if (f.frame < r.firstTearFrame) continue;
+    torn = std::max(torn, pipeline::measureFrame(f).cMean);
+    ++tornFrames;
+    if (!f.rulings.empty() && !f.junctionVertices.empty()) ++withRulings;
+    if (f.frame > r.firstTearFrame && f.rulings != lastRulings) ++rulingChanges;
+    lastRulings = f.rulings;
   }
   std::printf(
       "[ measure ] cylinder-fold with [tear]: tore at frame %d at a junction, %zu "
-      "advances, ran on to frame %d; c_mean of the torn frames at most %.4f %%\n",
+      "advances in S_G, ran on to frame %d as the crumpling model; %d of its %d torn frames "
+      "have rulings and junctions, the rulings changed in %d; c_mean of the torn frames at "
+      "most %.4f %%\n",
       r.firstTearFrame, r.tearAdvances.size(), reader.readFrame(reader.frameCount() - 1).frame,
-      100.0 * torn);
+      withRulings, tornFrames, rulingChanges, 100.0 * torn);
+  EXPECT_EQ(withRulings, tornFrames);
+  EXPECT_GT(rulingChanges, 0) << "the geometric step goes on after the tear";
   EXPECT_LE(torn, 0.005);
 }
 

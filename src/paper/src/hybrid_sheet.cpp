@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "crumple/core/error.hpp"
+#include "crumple/core/geometry2d.hpp"
 #include "crumple/paper/boundary_curve.hpp"
 #include "crumple/paper/cone_fit.hpp"
 #include "crumple/paper/damage.hpp"
@@ -260,6 +261,53 @@ void HybridSheet::setContacts(sim::ContactOptions options) {
 }
 
 const std::vector<sim::ContactSample>& HybridSheet::contacts() const { return impl_->contacts; }
+
+// Issue 6, thesis 3.3.3 "Remeshing" (Figs. 3.20-3.23).
+std::optional<std::vector<GeometricCutResult>> HybridSheet::tear(
+    const std::vector<TearAdvance>& advances, const GeometricCutOptions& options) {
+  Impl& m = *impl_;
+  GeometricMesh g = m.sg;
+  const std::vector<Vec3>& x = m.elastic->positions();
+  const std::vector<Vec3>& v = m.elastic->velocities();
+  for (std::size_t i = 0; i < g.vertices.size(); ++i) {
+    g.vertices[i].position = x[i];
+    g.vertices[i].velocity = v[i];
+  }
+  // The cuts' new vertices on S_P as the elastic step left it (finer than
+  // S_G's triangles).
+  GeometricCutOptions onSurface = options;
+  const mesh::SheetMesh& sp = m.sp.mesh;
+  onSurface.surface = [&](const Vec2& p, Vec3& position, Vec3& velocity) {
+    for (const auto& t : sp.triangles) {
+      const Vec2& a = sp.pattern[static_cast<std::size_t>(t[0])];
+      const Vec2& b = sp.pattern[static_cast<std::size_t>(t[1])];
+      const Vec2& c = sp.pattern[static_cast<std::size_t>(t[2])];
+      const double area = cross2(b - a, c - a);
+      const double wa = cross2(b - p, c - p) / area, wb = cross2(c - p, a - p) / area;
+      const double wc = 1.0 - wa - wb;
+      if (!(area > 0.0) || wa < -1e-9 || wb < -1e-9 || wc < -1e-9) continue;
+      position = wa * x[static_cast<std::size_t>(t[0])] + wb * x[static_cast<std::size_t>(t[1])] +
+                 wc * x[static_cast<std::size_t>(t[2])];
+      velocity = wa * v[static_cast<std::size_t>(t[0])] + wb * v[static_cast<std::size_t>(t[1])] +
+                 wc * v[static_cast<std::size_t>(t[2])];
+      return true;
+    }
+    return false;
+  };
+  std::vector<GeometricCutResult> out;
+  for (const TearAdvance& a : advances) {
+    auto cut = cutGeometricMesh(g, a.from, a.to, onSurface, a.previousDirection);
+    if (!cut) return std::nullopt;
+    out.push_back(std::move(*cut));
+  }
+  const std::vector<Vec2> patternBefore = m.sp.mesh.pattern;
+  const std::vector<sim::ContactSample> contactsBefore = m.contacts;
+  m.sg = std::move(g);
+  m.isometry.reset();
+  m.rebuildPhysical();
+  m.carryContacts(contactsBefore, patternBefore);
+  return out;
+}
 
 const sim::ElasticSheet& HybridSheet::elastic() const { return *impl_->elastic; }
 const GeometricMesh& HybridSheet::geometric() const { return impl_->sg; }

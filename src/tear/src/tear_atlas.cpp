@@ -323,6 +323,7 @@ TearAtlas bakeTearAtlas(const mesh::SheetMesh& mesh, const std::vector<TearSegme
   const double extent =
       lo.allFinite() ? std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff()) : 0.0;
   const double tol = 1e-9 * std::max(extent, 1e-3);
+  const double lipTol = std::max(tol, params.lipTolerance);
   const double reach = 4.0 * (lo.allFinite() ? (hi - lo).norm() : 0.0) + 1e3 * texel;
 
   std::vector<Chain> chains = chainsOf(segments, tol, 0.5 * texel);
@@ -374,8 +375,8 @@ TearAtlas bakeTearAtlas(const mesh::SheetMesh& mesh, const std::vector<TearSegme
       for (std::size_t c = 0; c < chains.size(); ++c) {
         const Closest ca = closestOnPolyline(chains[c].cut, a);
         const Closest cb = closestOnPolyline(chains[c].cut, b);
-        if (ca.distance > tol || cb.distance > tol || std::abs(ca.param - cb.param) <= tol ||
-            closestOnPolyline(chains[c].cut, 0.5 * (a + b)).distance > tol)
+        if (ca.distance > lipTol || cb.distance > lipTol || std::abs(ca.param - cb.param) <= tol ||
+            closestOnPolyline(chains[c].cut, 0.5 * (a + b)).distance > lipTol)
           continue;
         Bordering& bd = borders[t];
         const LipSide side = ca.param < cb.param ? LipSide::Left : LipSide::Right;
@@ -414,7 +415,7 @@ TearAtlas bakeTearAtlas(const mesh::SheetMesh& mesh, const std::vector<TearSegme
            {p[0], p[1], p[2], Vec2((p[0] + p[1] + p[2]) / 3.0), Vec2(0.5 * (p[0] + p[1])),
             Vec2(0.5 * (p[1] + p[2])), Vec2(0.5 * (p[2] + p[0]))}) {
         const Closest near = closestOnPolyline(ch.cut, q);
-        if (near.distance <= tol || !ch.inside(near.param, tol)) continue;
+        if (near.distance <= lipTol || !ch.inside(near.param, tol)) continue;
         (leftOf(ch.paddedCut, q, texel) ? left : right) += 1;
       }
       if ((left > 0) == (right > 0)) continue;  // beyond the ends (or astride: cannot be)
@@ -455,8 +456,8 @@ TearAtlas bakeTearAtlas(const mesh::SheetMesh& mesh, const std::vector<TearSegme
       const Vec2 d = (b - a).normalized();
       const Vec2 out(d.y(), -d.x());  // away from the triangle
       const double w = ch.support;
-      patch.polygon.push_back(a + w * out - (ch.turnsAwayFromQuads(a, side, tol) ? w : 0.0) * d);
-      patch.polygon.push_back(b + w * out + (ch.turnsAwayFromQuads(b, side, tol) ? w : 0.0) * d);
+      patch.polygon.push_back(a + w * out - (ch.turnsAwayFromQuads(a, side, lipTol) ? w : 0.0) * d);
+      patch.polygon.push_back(b + w * out + (ch.turnsAwayFromQuads(b, side, lipTol) ? w : 0.0) * d);
     }
     Vec2 plo = Vec2::Constant(kInf), phi = -plo;
     for (const Vec2& q : patch.polygon) {

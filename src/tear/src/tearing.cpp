@@ -1,10 +1,13 @@
 #include "crumple/tear/tearing.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 
+#include "crumple/core/geometry2d.hpp"
 #include "crumple/tear/candidates.hpp"
 
 namespace crumple::tear {
@@ -131,9 +134,33 @@ TearFrameResult Tearing::step(mesh::SheetMesh& mesh, const std::vector<int>& jun
        ++k)
     advances.push_back({starts[k], -1});
 
+  // Each boundary vertex's neighbours along the outline (for minStartAngle).
+  std::vector<std::array<int, 2>> around;
+  if (params_.minStartAngle > 0.0) {
+    around.assign(mesh.vertexCount(), {-1, -1});
+    for (const auto& loop : boundaryLoops(mesh))
+      for (std::size_t k = 0; k < loop.size(); ++k)
+        around[static_cast<std::size_t>(loop[k])] = {loop[(k + loop.size() - 1) % loop.size()],
+                                                     loop[(k + 1) % loop.size()]};
+  }
   for (const Advance& a : advances) {
     const CandidateTest& t = *a.test;
     const Vec2 from = mesh.pattern[static_cast<std::size_t>(t.candidate.vertex)];
+    if (a.tear < 0 && params_.minStartAngle > 0.0) {
+      double angle = std::numbers::pi;
+      for (int n : around[static_cast<std::size_t>(t.candidate.vertex)]) {
+        if (n < 0) continue;
+        const Vec2 along = mesh.pattern[static_cast<std::size_t>(n)] - from;
+        const Vec2& d = t.propagation.direction;
+        angle = std::min(angle, std::atan2(std::abs(cross2(along, d)), along.dot(d)));
+      }
+      if (angle < params_.minStartAngle) {
+        result.skipped.push_back(
+            "vertex " + std::to_string(t.candidate.vertex) + ": it would start " +
+            std::to_string(angle * 180.0 / std::numbers::pi) + " deg from the outline");
+        continue;
+      }
+    }
     // s_{t+1} = s_t + V E_r d_prop (thesis 3.3.3), the step held to what the mesh can show.
     const double length =
         std::clamp(params_.griffith.speed * t.propagation.energyRelease,
@@ -157,10 +184,15 @@ bool Tearing::cutTo(mesh::SheetMesh& mesh, int vertex, const Vec2& to, TearEvent
     options.snap = params_.snap;
     options.fixed = &held;
     cut = cutAlong(trial, vertex, to, options);
-  } catch (const std::invalid_argument&) {
-    return false;  // the direction leaves the sheet here: no tear from this point
+  } catch (const std::invalid_argument& ex) {
+    // The direction leaves the sheet here: no tear from this point.
+    result.skipped.push_back("vertex " + std::to_string(vertex) + ": " + ex.what());
+    return false;
   }
-  if (cut.chain.size() < 2) return false;
+  if (cut.chain.size() < 2) {
+    result.skipped.push_back("vertex " + std::to_string(vertex) + ": the cut snaps back onto it");
+    return false;
+  }
   mesh = std::move(trial);
   lip_.resize(mesh.vertexCount(), 0);
   for (int v : cut.chain) lip_[static_cast<std::size_t>(v)] = 1;
@@ -221,6 +253,66 @@ bool Tearing::cutTo(mesh::SheetMesh& mesh, int vertex, const Vec2& to, TearEvent
   seg.detail = detailPath(fibers_, e.from, e.to, params_.detail);
   segments_.push_back(std::move(seg));
   return true;
+}
+
+void Tearing::rebind(const mesh::SheetMesh& mesh, double lipTolerance) {
+  std::vector<int> boundary;
+  for (const auto& loop : boundaryLoops(mesh))
+    boundary.insert(boundary.end(), loop.begin(), loop.end());
+  double extent = 0.0;
+  for (const Vec2& q : mesh.pattern) extent = std::max(extent, q.cwiseAbs().maxCoeff());
+  const double same = 1e-9 * std::max(extent, 1e-3);
+  const auto at = [&](int v) -> const Vec2& { return mesh.pattern[static_cast<std::size_t>(v)]; };
+  for (std::size_t tear = 0; tear < tips_.size(); ++tear) {
+    if (tips_[tear] < 0) continue;
+    const auto last = std::find_if(segments_.rbegin(), segments_.rend(), [&](const TearSegment& s) {
+      return s.tear == static_cast<int>(tear);
+    });
+    const Vec2 tip = last->cut.back();
+    const auto it = std::find_if(boundary.begin(), boundary.end(),
+                                 [&](int v) { return (at(v) - tip).norm() <= same; });
+    if (it == boundary.end())
+      throw std::runtime_error("Tearing::rebind: tear " + std::to_string(tear) +
+                               "'s tip is not a boundary vertex of the mesh");
+    tips_[tear] = *it;
+  }
+  lip_.assign(mesh.vertexCount(), 0);
+  for (const TearSegment& s : segments_)
+    for (int v : boundary)
+      for (std::size_t k = 0; k + 1 < s.cut.size(); ++k)
+        if (distanceToSegment(at(v), s.cut[k], s.cut[k + 1]) <= lipTolerance) {
+          lip_[static_cast<std::size_t>(v)] = 1;
+          break;
+        }
+  // Thesis Fig. 3.20: a former tip where the tear turned by more than eps_a
+  // is a point it may branch from.
+  for (std::size_t i = 0; i < segments_.size(); ++i)
+    for (std::size_t j = i + 1; j < segments_.size(); ++j) {
+      if (segments_[j].tear != segments_[i].tear) continue;
+      const Vec2 before = segments_[i].cut.back() - segments_[i].cut.front();
+      const Vec2 after = segments_[j].cut.back() - segments_[j].cut.front();
+      const double turn = std::atan2(std::abs(cross2(before, after)), before.dot(after));
+      if (turn > params_.branchAngle)
+        for (int v : boundary)
+          if ((at(v) - segments_[j].cut.front()).norm() <= lipTolerance)
+            lip_[static_cast<std::size_t>(v)] = 0;
+      break;
+    }
+}
+
+void Tearing::recut(const std::vector<std::vector<Vec2>>& cuts) {
+  if (cuts.size() > segments_.size())
+    throw std::invalid_argument("Tearing::recut: more cuts than advances");
+  const std::size_t first = segments_.size() - cuts.size();
+  const double moved = 0.5 * fibers_.texelSize();
+  for (std::size_t k = 0; k < cuts.size(); ++k) {
+    if (cuts[k].size() < 2) throw std::invalid_argument("Tearing::recut: a cut needs two points");
+    TearSegment& s = segments_[first + k];
+    if ((cuts[k].front() - s.detail.front()).norm() > moved ||
+        (cuts[k].back() - s.detail.back()).norm() > moved)
+      s.detail = detailPath(fibers_, cuts[k].front(), cuts[k].back(), params_.detail);
+    s.cut = cuts[k];
+  }
 }
 
 TearFrameResult Tearing::replay(mesh::SheetMesh& mesh, const std::vector<TearEvent>& events,

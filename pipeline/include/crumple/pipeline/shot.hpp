@@ -95,8 +95,13 @@ struct ShotReport {
   std::vector<tear::TearSegment> tearSegments;
   std::vector<tear::CandidateKind> tearStartKinds;  // per tear
   int firstTearFrame = -1;
-  // Crumpling model: the frame from which the torn sheet went on as the
-  // elastic model on its last S_P (-1: it never tore).
+  // Crumpling model: advances made in S_G (the model goes on crumpling the
+  // torn sheet), and the curved regions they turned flat (cases 1-2).
+  int tearGeometricCuts = 0;
+  int tearRegionsFlattened = 0;
+  // Crumpling model: the frame from which the sheet went on as the elastic
+  // model on the scene's rectangle mesh, when a tear came apart into pieces
+  // (S_G is one piece) or S_G could not take a cut (-1: never).
   int tearHandoverFrame = -1;
   double tearMs = 0.0;      // candidates, Griffith tests, cuts, detail paths, baking (wall time)
   double tearBakeMs = 0.0;  // of which baking the tear textures

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "crumple/paper/enrich.hpp"
@@ -15,6 +16,7 @@
 #include "crumple/paper/geometric_step.hpp"
 #include "crumple/paper/isometry.hpp"
 #include "crumple/paper/params.hpp"
+#include "crumple/paper/tear_remesh.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
 
 namespace crumple::paper {
@@ -86,6 +88,23 @@ class HybridSheet {
   void placeVertices(const std::vector<sim::Pin>& pins);
   // The time the sheet is at before the first step (s).
   void setTime(double t);
+
+  // One advance of a tear (thesis 3.3.3), in the pattern: from s_t (on the
+  // outline) to s_{t+1}; `previousDirection`: the tear's last advance's
+  // direction when s_t is its tip.
+  struct TearAdvance {
+    Vec2 from = Vec2::Zero();
+    Vec2 to = Vec2::Zero();
+    std::optional<Vec2> previousDirection;
+  };
+  // Tears the sheet (issue 6, thesis 3.3.3 "Remeshing"): S_G takes the
+  // current positions and velocities of S_P, each advance cuts it in turn
+  // (cutGeometricMesh), and S_P is rebuilt from it; the model goes on
+  // crumpling the torn sheet. All or nothing: std::nullopt, the sheet as it
+  // was, when an advance would tear S_G in two (cutGeometricMesh); the
+  // exceptions of cutGeometricMesh likewise leave it as it was.
+  std::optional<std::vector<GeometricCutResult>> tear(const std::vector<TearAdvance>& advances,
+                                                      const GeometricCutOptions& options);
 
   // The elastic model on the current S_P, at the end of the last step: S_P's
   // positions and velocities, its hinges' rest angles and stiffness factors

@@ -24,6 +24,11 @@ struct TearAtlasParams {
   // Texels added to the support quads' width beyond the detail path's
   // largest distance from its cut.
   double margin = 2.0;
+  // How far (m) a lip's points may lie from the cut: 0 for a mesh cut along
+  // the cut itself (cutAlong: within 1e-9 of the extent); the crumpling
+  // model's lips are a slit (paper::GeometricCutOptions::kerf) whose points
+  // are up to a few kerfs off the cut's centre line.
+  double lipTolerance = 0.0;
 };
 
 // The patches of every tear in `segments` over the mesh they cut (a pure

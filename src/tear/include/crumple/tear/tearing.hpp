@@ -7,6 +7,7 @@
 // (cutAlong) and every advance is recorded with its detail path
 // (TearSegment) for the baked tear textures.
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "crumple/mesh/sheet_mesh.hpp"
@@ -36,6 +37,11 @@ struct TearingParams {
   // inward corner: the tear may branch there); elsewhere a tear's lips are
   // not candidates.
   double branchAngle = 0.1;
+  // A new tear whose direction makes less than this angle (rad) with the
+  // outline at its start does not start (0: any). The crumpling model's
+  // coarse S_G cannot mesh the thin strip such a tear leaves along the
+  // outline (its elastic step fails on the sliver triangles).
+  double minStartAngle = 0.0;
 };
 
 // One advance of one tear in a frame.
@@ -60,6 +66,8 @@ struct TearFrameResult {
   // Vertices from before the frame that moved onto a cut (CutOptions::snap),
   // their new place over the vertices before the frame.
   std::vector<std::pair<int, VertexBlend>> relocated;
+  // Advances that tore (E_r >= E_f) but could not be cut, and why.
+  std::vector<std::string> skipped;
   bool changed() const { return !events.empty(); }
 };
 
@@ -85,6 +93,21 @@ class Tearing {
   // tears (std::logic_error otherwise).
   TearFrameResult replay(mesh::SheetMesh& mesh, const std::vector<TearEvent>& events,
                          const std::vector<char>& held);
+
+  // The crumpling model's sheet (issue 6, docs/TEARING.md "The crumpling
+  // model torn"): its cuts are made in S_G (paper::cutGeometricMesh) and S_P
+  // is rebuilt from S_G every animation step, with new vertex numbers. This
+  // finds each tear's tip again on `mesh` (the boundary vertex at the last
+  // point of its cut) and its lips (boundary vertices within `lipTolerance`
+  // of a cut, but for the former tips where it turned by more than
+  // branchAngle). Throws std::runtime_error when a tip is not a vertex of
+  // the mesh.
+  void rebind(const mesh::SheetMesh& mesh, double lipTolerance);
+  // Replaces the cuts of the last cuts.size() advances by the given
+  // polylines (how S_G took them); the detail path is walked again between
+  // the new ends where they moved. Throws std::invalid_argument for more
+  // cuts than advances or a cut of fewer than two points.
+  void recut(const std::vector<std::vector<Vec2>>& cuts);
 
   // Every advance so far, in order.
   const std::vector<TearSegment>& segments() const { return segments_; }
