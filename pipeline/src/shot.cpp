@@ -452,6 +452,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     if (hybrid) {
       tearParams.snap = paper::GeometricCutOptions{}.snap;
       tearParams.minStartAngle = kMinStartAngle;
+      tearParams.maxTurn = paper::GeometricCutOptions{}.maxTurn;
     }
     tearing.emplace(sheet, tearParams, seed);
     report.tearingOn = true;

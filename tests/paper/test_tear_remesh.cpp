@@ -4,8 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <map>
+#include <optional>
+#include <string>
 
 #include "crumple/core/geometry2d.hpp"
+#include "crumple/core/rng.hpp"
 #include "crumple/paper/enrich.hpp"
 #include "crumple/paper/geometric_step.hpp"
 #include "crumple/paper/initial_sheet.hpp"
@@ -138,4 +144,61 @@ TEST(TearRemesh, ACurvedRegionTheTearCrossesBecomesFlat) {
   for (const GeometricFace& f : g.faces) EXPECT_EQ(f.size(), 3);
   const PhysicalMesh sp = buildPhysicalMesh(g, CrumpleParams{});
   EXPECT_EQ(mesh::validate(sp.mesh), "");
+}
+
+// Hard cases: 60 sheets, each torn by up to 6 advances in random directions
+// and lengths from random outline points, then from the tips. Every cut
+// either leaves a valid S_G on which S_P builds, or is refused (std::nullopt
+// or std::invalid_argument) with S_G exactly as it was.
+TEST(TearRemesh, RandomTearsKeepSGValidOrLeaveItUnchanged) {
+  const CounterRng rng(7, 0, RngPurpose::Generic);
+  std::uint64_t draw = 0;
+  int made = 0, refused = 0;
+  std::map<std::string, int> reasons;  // why cuts were refused (their text up to a number)
+  for (int sheet = 0; sheet < 60; ++sheet) {
+    GeometricMesh g = flatSheet();
+    std::optional<Vec2> tip, direction;
+    for (int step = 0; step < 6; ++step) {
+      Vec2 from;
+      if (tip) {
+        from = *tip;
+      } else {
+        const double s = rng.uniform(draw++) * outlinePerimeter(g);
+        from = outlinePoint(g, s);
+      }
+      const double angle = 2.0 * std::numbers::pi * rng.uniform(draw++);
+      const double length = 0.002 + 0.03 * rng.uniform(draw++);
+      const Vec2 to = from + length * Vec2(std::cos(angle), std::sin(angle));
+      const GeometricMesh before = g;
+      std::optional<GeometricCutResult> cut;
+      try {
+        cut = cutGeometricMesh(g, from, to, {}, tip ? direction : std::nullopt);
+      } catch (const std::invalid_argument& e) {
+        const std::string why = e.what();
+        ++reasons[why.substr(0, why.find_first_of("0123456789"))];
+        cut.reset();
+      }
+      if (!cut) {
+        ++refused;
+        EXPECT_EQ(g.faces, before.faces);
+        EXPECT_EQ(g.vertices.size(), before.vertices.size());
+        tip.reset();
+        continue;
+      }
+      ++made;
+      ASSERT_EQ(validate(g), "") << "sheet " << sheet << " step " << step;
+      PhysicalMesh sp;
+      ASSERT_NO_THROW(sp = buildPhysicalMesh(g, CrumpleParams{}))
+          << "sheet " << sheet << " step " << step << " from " << from.transpose() << " to "
+          << to.transpose() << " after " << direction.value_or(Vec2::Zero()).transpose();
+      ASSERT_EQ(mesh::validate(sp.mesh), "") << "sheet " << sheet << " step " << step;
+      direction = (cut->cut.back() - cut->cut.front()).normalized();
+      tip = cut->cut.back();
+    }
+  }
+  std::printf("[ measure ] random tears: %d cuts made, %d refused\n", made, refused);
+  for (const auto& [why, n] : reasons) std::printf("[ measure ]   %d: %s\n", n, why.c_str());
+  // Every refusal is one of the documented ones (no invalid S_G).
+  for (const auto& [why, n] : reasons) EXPECT_EQ(why.find("after the cut"), std::string::npos) << why;
+  EXPECT_GT(made, 100);
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -179,6 +180,14 @@ std::optional<GeometricCutResult> cutGeometricMesh(GeometricMesh& g, const Vec2&
     throw std::invalid_argument("cutGeometricMesh: kerf must be finite and > 0");
   if (!from.allFinite() || !to.allFinite())
     throw std::invalid_argument("cutGeometricMesh: non-finite advance");
+  if (previousDirection) {
+    const Vec2 d = to - from;
+    const double turn =
+        std::atan2(std::abs(cross2(*previousDirection, d)), previousDirection->dot(d));
+    if (turn > options.maxTurn)
+      throw std::invalid_argument("cutGeometricMesh: the tear would turn back by " +
+                                  std::to_string(turn * 180.0 / std::numbers::pi) + " degrees");
+  }
   GeometricMesh h = g;
   const double perimeter = outlinePerimeter(h);
   const double tol = 1e-9 * perimeter;

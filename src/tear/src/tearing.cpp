@@ -146,6 +146,21 @@ TearFrameResult Tearing::step(mesh::SheetMesh& mesh, const std::vector<int>& jun
   for (const Advance& a : advances) {
     const CandidateTest& t = *a.test;
     const Vec2 from = mesh.pattern[static_cast<std::size_t>(t.candidate.vertex)];
+    if (a.tear >= 0 && params_.maxTurn < std::numbers::pi) {
+      const auto last = std::find_if(segments_.rbegin(), segments_.rend(),
+                                     [&](const TearSegment& seg) { return seg.tear == a.tear; });
+      if (last != segments_.rend()) {
+        const Vec2 before = last->cut.back() - last->cut.front();
+        const Vec2& d = t.propagation.direction;
+        const double turn = std::atan2(std::abs(cross2(before, d)), before.dot(d));
+        if (turn > params_.maxTurn) {
+          result.skipped.push_back("vertex " + std::to_string(t.candidate.vertex) +
+                                   ": the tear would turn back by " +
+                                   std::to_string(turn * 180.0 / std::numbers::pi) + " deg");
+          continue;
+        }
+      }
+    }
     if (a.tear < 0 && params_.minStartAngle > 0.0) {
       double angle = std::numbers::pi;
       for (int n : around[static_cast<std::size_t>(t.candidate.vertex)]) {

@@ -18,6 +18,7 @@
 // that the outline stays a simple polygon: every S_G query by pattern point
 // (outline segment, boundary curve, point in face) keeps one answer.
 #include <functional>
+#include <numbers>
 #include <optional>
 #include <vector>
 
@@ -41,6 +42,10 @@ struct GeometricCutOptions {
   // model's S_P). Returns false where it does not know; nullptr, or false:
   // interpolated in the S_G triangle the vertex splits.
   std::function<bool(const Vec2& pattern, Vec3& position, Vec3& velocity)> surface;
+  // The largest turn (rad) from `previousDirection` a cut may take: the
+  // slit's two copies of s_t meet where the lips' kerf lines cross, which a
+  // tear turning back on itself does not have.
+  double maxTurn = 0.5 * std::numbers::pi;
 };
 
 struct GeometricCutResult {
@@ -59,7 +64,8 @@ struct GeometricCutResult {
 // as it was, when the cut reaches the outline again (the sheet would come
 // apart: S_G is one piece with one outline). Throws std::invalid_argument
 // when `from` is not on the outline, the cut leaves the sheet at once, or
-// S_G would not be valid afterwards (validate), leaving `g` as it was.
+// S_G would not be valid afterwards (validate), or the cut turns by more
+// than options.maxTurn from previousDirection, leaving `g` as it was.
 std::optional<GeometricCutResult> cutGeometricMesh(
     GeometricMesh& g, const Vec2& from, const Vec2& to, const GeometricCutOptions& options = {},
     const std::optional<Vec2>& previousDirection = std::nullopt);

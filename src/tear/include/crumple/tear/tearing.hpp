@@ -7,6 +7,7 @@
 // (cutAlong) and every advance is recorded with its detail path
 // (TearSegment) for the baked tear textures.
 #include <cstdint>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,10 @@ struct TearingParams {
   // coarse S_G cannot mesh the thin strip such a tear leaves along the
   // outline (its elastic step fails on the sliver triangles).
   double minStartAngle = 0.0;
+  // A tip does not advance in a direction that turns by more than this
+  // (rad) from its tear's last advance (pi: any). The crumpling model's
+  // slit cannot turn back on itself.
+  double maxTurn = std::numbers::pi;
 };
 
 // One advance of one tear in a frame.
