@@ -21,6 +21,8 @@ find_package(embree 3.13 REQUIRED CONFIG)
 find_package(OpenEXR 3.1 REQUIRED CONFIG)
 # OSMesa only: linking libGL as well turns every GL call into a no-op.
 pkg_check_modules(OSMESA REQUIRED IMPORTED_TARGET osmesa)
+# libsndfile (the soundtrack's WAV files).
+pkg_check_modules(SNDFILE REQUIRED IMPORTED_TARGET sndfile)
 
 # CHOLMOD (SuiteSparse 5.12) ships neither a CMake config nor a .pc file.
 find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
