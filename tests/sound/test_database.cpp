@@ -2,7 +2,6 @@
 // WAVs and spectra the test writes, read back, looked up; and every way an
 // index or a file can be wrong, named.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -13,6 +12,7 @@
 #include "crumple/core/error.hpp"
 #include "crumple/sound/database.hpp"
 #include "crumple/sound/wav.hpp"
+#include "scratch.hpp"
 
 using namespace crumple;
 using namespace crumple::sound;
@@ -20,21 +20,24 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Scratch {
-  fs::path dir;
+// A scratch folder with the database's two subfolders.
+struct Scratch : crumple::testing::SoundScratch {
   Scratch() {
-    dir = fs::temp_directory_path() /
-          ("crumple-test-sounddb-" + std::to_string(::getpid()) + "-" +
-           ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir);
     fs::create_directories(dir / "crumpling");
     fs::create_directories(dir / "friction");
   }
-  ~Scratch() {
-    std::error_code ignored;
-    fs::remove_all(dir, ignored);
-  }
 };
+
+// Replaces the first `from` in DIR/index.toml by `to`.
+void editIndex(const fs::path& dir, const std::string& from, const std::string& to) {
+  std::string text;
+  {
+    std::ifstream in(dir / "index.toml");
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  text.replace(text.find(from), from.size(), to);
+  std::ofstream(dir / "index.toml") << text;
+}
 
 // A decaying sine clip of `hz` (mono).
 void writeClip(const fs::path& path, double hz, int rate = 48000, int channels = 1) {
@@ -159,31 +162,11 @@ TEST(SoundDatabase, NamesWhatIsWrong) {
                 std::ofstream out(d / "friction/neg.txt");
                 out << "# x\n1.0\n-2.0\n";
               });
-  expectError("", "version 2", [](const fs::path& d) {
-    std::string text;
-    {
-      std::ifstream in(d / "index.toml");
-      text.assign(std::istreambuf_iterator<char>(in), {});
-    }
-    text.replace(text.find("version = 1"), 11, "version = 2");
-    std::ofstream(d / "index.toml") << text;
-  });
-  expectError("", "fft_size", [](const fs::path& d) {
-    std::string text;
-    {
-      std::ifstream in(d / "index.toml");
-      text.assign(std::istreambuf_iterator<char>(in), {});
-    }
-    text.replace(text.find("fft_size = 64"), 13, "fft_size = 100");
-    std::ofstream(d / "index.toml") << text;
-  });
+  expectError("", "version 2",
+              [](const fs::path& d) { editIndex(d, "version = 1", "version = 2"); });
+  expectError("", "fft_size",
+              [](const fs::path& d) { editIndex(d, "fft_size = 64", "fft_size = 100"); });
   expectError("", "constrained cell", [](const fs::path& d) {
-    std::string text;
-    {
-      std::ifstream in(d / "index.toml");
-      text.assign(std::istreambuf_iterator<char>(in), {});
-    }
-    text.replace(text.find("l_r_cm = 0.0\nl_c_cm = 0.0"), 25, "l_r_cm = 1.5\nl_c_cm = 0.5");
-    std::ofstream(d / "index.toml") << text;
+    editIndex(d, "l_r_cm = 0.0\nl_c_cm = 0.0", "l_r_cm = 1.5\nl_c_cm = 0.5");
   });
 }

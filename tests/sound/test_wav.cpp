@@ -1,6 +1,5 @@
 // The soundtrack's clock and WAV files (issue 7, item 6).
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -10,26 +9,14 @@
 #include <string>
 
 #include "crumple/sound/wav.hpp"
+#include "scratch.hpp"
 
 using namespace crumple::sound;
 namespace fs = std::filesystem;
 
 namespace {
 
-// A scratch folder removed with the test.
-struct Scratch {
-  fs::path dir;
-  Scratch() {
-    dir = fs::temp_directory_path() /
-          ("crumple-test-sound-" + std::to_string(::getpid()) + "-" +
-           ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir);
-  }
-  ~Scratch() {
-    std::error_code ignored;
-    fs::remove_all(dir, ignored);
-  }
-};
+using Scratch = crumple::testing::SoundScratch;
 
 Audio sine(int rate, std::size_t n, double hz, double amplitude, int channels = 1) {
   Audio a;
