@@ -23,6 +23,8 @@ find_package(OpenEXR 3.1 REQUIRED CONFIG)
 pkg_check_modules(OSMESA REQUIRED IMPORTED_TARGET osmesa)
 # libsndfile (the soundtrack's WAV files).
 pkg_check_modules(SNDFILE REQUIRED IMPORTED_TARGET sndfile)
+# FFTW 3 (the friction noise's inverse FFTs).
+pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3)
 
 # CHOLMOD (SuiteSparse 5.12) ships neither a CMake config nor a .pc file.
 find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)

@@ -10,7 +10,7 @@ PACKAGES=(
   libeigen3-dev libsuitesparse-dev libopenblas0
   libassimp-dev libosmesa6-dev libpng-dev libembree-dev libopenexr-dev libfcl-dev
   libtomlplusplus-dev libcli11-dev
-  libsndfile1-dev
+  libsndfile1-dev libfftw3-dev
   libcgal-dev libgmp-dev libmpfr-dev
   libgtest-dev libbenchmark-dev
   "$@"
