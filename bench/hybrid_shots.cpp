@@ -65,7 +65,7 @@ Run runOnce(const io::SceneSpec& scene, int lastFrame, const std::string& outDir
   pipeline::ShotOptions options;
   options.outDir = outDir;
   options.render = false;
-  options.log = std::fopen("/dev/null", "w");
+  options.log = nullptr;  // quiet
   options.interactive = 0;
   if (lastFrame >= 0)
     options.frames = pipeline::FrameRange{scene.frameStart, std::min(lastFrame, scene.frameEnd)};
@@ -77,7 +77,6 @@ Run runOnce(const io::SceneSpec& scene, int lastFrame, const std::string& outDir
     run.error = e.what();
     // The summary of the frames that did run is still written.
   }
-  std::fclose(options.log);
   if (!run.error.empty()) return fromSummary(outDir, run.error);
   for (const auto& [name, cost] : report.stages) {
     if (name == "cache" || name == "render") continue;

@@ -419,7 +419,8 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   report.warnings.insert(report.warnings.end(), rig.bindWarnings().begin(),
                          rig.bindWarnings().end());
   // Said now as well as in the summary: they often explain a failure that follows.
-  for (const auto& w : report.warnings) std::fprintf(options.log, "warning: %s\n", w.c_str());
+  if (options.log != nullptr)
+    for (const auto& w : report.warnings) std::fprintf(options.log, "warning: %s\n", w.c_str());
   report.summaryPath = (fs::path(report.outDir) / "summary.json").string();
   std::unique_ptr<detail::FrameRenderer> renderer;
   if (render) {

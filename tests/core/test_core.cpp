@@ -1,12 +1,15 @@
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstring>
 #include <numeric>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "crumple/core/crc32.hpp"
 #include "crumple/core/parallel.hpp"
+#include "crumple/core/progress.hpp"
 #include "crumple/core/rng.hpp"
 #include "crumple/core/units.hpp"
 
@@ -79,4 +82,25 @@ TEST(ParallelFor, RethrowsAWorkerException) {
                    10),
                std::runtime_error);
   setThreadCount(1);
+}
+
+// Progress lines: "PROGRESS <percent>" per step when not a terminal, and
+// nothing at all with no stream (a quiet run, ShotOptions::log = nullptr).
+TEST(Progress, WritesOneLinePerStepOrNothingWithoutAStream) {
+  std::FILE* f = std::tmpfile();
+  ASSERT_NE(f, nullptr);
+  {
+    crumple::Progress p("work", 4, f, 0);
+    for (long i = 1; i <= 4; ++i) p.update(i);
+    p.finish();
+  }
+  std::rewind(f);
+  std::string text;
+  for (int c; (c = std::fgetc(f)) != EOF;) text.push_back(static_cast<char>(c));
+  std::fclose(f);
+  EXPECT_EQ(text, "PROGRESS 25\nPROGRESS 50\nPROGRESS 75\nPROGRESS 100\n");
+  crumple::Progress quiet("work", 4, nullptr, -1);
+  EXPECT_FALSE(quiet.interactive());
+  quiet.update(2);  // no stream: nothing to write to, and no crash
+  quiet.finish();
 }

@@ -42,7 +42,7 @@ Shot simulate(const std::string& sample, int last, std::optional<std::uint64_t> 
   options.render = false;
   options.frames = pipeline::FrameRange{scene.frameStart, last};
   options.seed = seed;
-  options.log = std::fopen("/dev/null", "w");
+  options.log = nullptr;  // quiet
   options.interactive = 0;
   Shot shot;
   try {
@@ -50,7 +50,6 @@ Shot simulate(const std::string& sample, int last, std::optional<std::uint64_t> 
   } catch (const NumericalError& e) {
     shot.error = e.what();
   }
-  std::fclose(options.log);
   const cache::CacheReader reader((dir / sample / "cache.pcache").string());
   for (std::size_t k = 0; k < reader.frameCount(); ++k) shot.frames.push_back(reader.readFrame(k));
   return shot;

@@ -10,10 +10,12 @@ Progress::Progress(std::string label, long total, std::FILE* out, int interactiv
     : label_(std::move(label)),
       total_(std::max(1L, total)),
       out_(out),
-      interactive_(interactive < 0 ? ::isatty(::fileno(out)) != 0 : interactive != 0),
+      interactive_(out != nullptr &&
+                   (interactive < 0 ? ::isatty(::fileno(out)) != 0 : interactive != 0)),
       start_(std::chrono::steady_clock::now()) {}
 
 void Progress::update(long done) {
+  if (out_ == nullptr) return;
   done = std::clamp(done, 0L, total_);
   const int percent = static_cast<int>(100 * done / total_);
   if (!interactive_) {

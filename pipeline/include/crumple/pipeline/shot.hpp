@@ -47,7 +47,7 @@ struct ShotOptions {
   bool render = true;                 // `run` renders, `simulate` does not
   bool debugStructure = false;        // render the crumpling model's structure view
   RenderSettings rendering;
-  std::FILE* log = stderr;  // progress and notes
+  std::FILE* log = stderr;  // progress and notes; nullptr: a quiet run
   int interactive = -1;     // -1: detect a terminal on `log`
 };
 
@@ -148,7 +148,7 @@ struct RenderOptions {
   std::string framesDir;             // default: <cache folder>/frames
   bool debugStructure = false;  // flat/curved regions, rulings, singular, junction, handle vertices
   RenderSettings rendering;
-  std::FILE* log = stderr;
+  std::FILE* log = stderr;  // progress; nullptr: a quiet run
   int interactive = -1;
 };
 struct RenderReport {

@@ -10,8 +10,8 @@ namespace crumple {
 
 class Progress {
  public:
-  // total: number of steps; label: what is being done; out: where to write.
-  // interactive: nullopt = detect with isatty on out.
+  // total: number of steps; label: what is being done; out: where to write
+  // (nullptr: nowhere, a quiet run). interactive: -1 = detect with isatty on out.
   Progress(std::string label, long total, std::FILE* out = stderr, int interactive = -1);
   // Mark `done` steps complete (monotonic) and report.
   void update(long done);
