@@ -17,6 +17,7 @@
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/shot.hpp"
+#include "crumple/pipeline/sound.hpp"
 #include "crumple/render/embree_renderer.hpp"
 #include "crumple/render/image_compare.hpp"
 
@@ -44,6 +45,12 @@ struct Args {
   // compare
   std::string imageA, imageB, metric = "flip", diff;
   double tolerance = 0.05;
+  // sound
+  std::optional<int> rate, channels;
+  std::string format, database;
+  std::optional<double> gainDb;
+  bool noSpectrogram = false;
+  bool listEvents = false;
 };
 
 pipeline::RenderSettings renderSettings(const Args& a) {
@@ -123,6 +130,39 @@ int renderCommand(const Args& a) {
     std::printf("  contact sheet: %s\n", report.contactSheetPath.c_str());
   if (!report.moviePath.empty()) std::printf("  movie:   %s\n", report.moviePath.c_str());
   for (const auto& n : report.notes) std::printf("  note: %s\n", n.c_str());
+  return 0;
+}
+
+int soundCommand(const Args& a) {
+  if (a.listEvents) {
+    std::fputs(pipeline::eventTimeline(a.cache).c_str(), stdout);
+    return 0;
+  }
+  pipeline::SoundOptions options;
+  options.out = a.out;
+  options.sampleRate = a.rate;
+  options.channels = a.channels;
+  if (!a.format.empty()) {
+    if (a.format != "pcm24" && a.format != "float")
+      throw InputError("--format", "'" + a.format + "' is not a format (pcm24 or float)");
+    options.floatSamples = a.format == "float";
+  }
+  options.database = a.database;
+  options.gainDb = a.gainDb;
+  options.spectrogram = !a.noSpectrogram;
+  const auto r = pipeline::makeSound(a.cache, options);
+  std::printf(
+      "soundtrack: %.3f s, %d frames, %d Hz, %s, synthesised in %.1f ms (%.0fx real time)\n"
+      "  events:  %ld crumpling (%ld clac, %ld flap resonators), %ld friction (%ld constrained, "
+      "%ld free resonators), %ld tearing\n"
+      "  level:   gain %+.1f dB, peak %.3f, %lld samples clipped\n"
+      "  database: %s\n  wav:     %s\n",
+      r.seconds, r.frames, r.sampleRate, r.channels == 1 ? "mono" : "stereo", r.synthesisMs,
+      r.synthesisMs > 0.0 ? 1000.0 * r.seconds / r.synthesisMs : 0.0, r.crumplingEvents,
+      r.clacResonators, r.flapResonators, r.frictionEvents, r.constrainedFriction, r.freeFriction,
+      r.tearingEvents, r.gainDb, r.peak, static_cast<long long>(r.clipped), r.databasePath.c_str(),
+      r.wavPath.c_str());
+  if (!r.spectrogramPath.empty()) std::printf("  spectrogram: %s\n", r.spectrogramPath.c_str());
   return 0;
 }
 
@@ -216,6 +256,28 @@ int main(int argc, char** argv) {
                    "embree: worker threads (the images are identical for any count); osmesa: "
                    "the rasteriser sizes its own threads (LP_NUM_THREADS), identical images too")
       ->check(CLI::Range(1, 256));
+  auto* soundCmd = app.add_subcommand(
+      "sound",
+      "Make the soundtrack of a cache whose scene has [sound]: crumpling, friction and tearing "
+      "sounds from the events the simulation stored, heard from the camera; a WAV lasting "
+      "exactly frame_count / fps, and its spectrogram PNG beside it.");
+  soundCmd->add_option("CACHE", a.cache, "a .pcache file")->required();
+  soundCmd->add_option("--out", a.out, "the WAV file (default: sound.wav beside the cache)");
+  soundCmd
+      ->add_option("--rate", a.rate, "sample rate: 48000 or 44100 (default: the scene's, 48000)")
+      ->check(CLI::IsMember({48000, 44100}));
+  soundCmd->add_option("--format", a.format,
+                       "pcm24 (24-bit PCM) or float (32-bit float) (default: the scene's, pcm24)");
+  soundCmd->add_option("--channels", a.channels, "1 (mono) or 2 (stereo) (default: the scene's, 2)")
+      ->check(CLI::IsMember({1, 2}));
+  soundCmd->add_option("--database", a.database,
+                       "sound database folder (default: the scene's [sound] database, else "
+                       "assets/sound/default)");
+  soundCmd->add_option("--gain-db", a.gainDb,
+                       "a fixed gain in dB (default: the mix's peak normalised to -1 dBFS)");
+  soundCmd->add_flag("--no-spectrogram", a.noSpectrogram, "do not write the PNG");
+  soundCmd->add_flag("--events", a.listEvents,
+                     "print the cache's sound events, one line each, and make no sound");
   auto* compare = app.add_subcommand(
       "compare",
       "Compare two images (PNG, or EXR as sRGB) for golden-image tests: exit 0 when within "
@@ -255,6 +317,7 @@ int main(int argc, char** argv) {
     if (*simulate) return runOrSimulate(a, false);
     if (*render) return renderCommand(a);
     if (*inspect) return inspectCommand(a);
+    if (*soundCmd) return soundCommand(a);
     if (*compare) return compareCommand(a);
   } catch (const InputError& e) {
     std::fprintf(stderr, "crumple: error: %s\n", e.what());

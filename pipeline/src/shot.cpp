@@ -18,6 +18,7 @@
 #include "crumple/core/error.hpp"
 #include "crumple/core/progress.hpp"
 #include "crumple/exporters/pcache_contacts.hpp"
+#include "crumple/exporters/pcache_sound.hpp"
 #include "crumple/exporters/pcache_tear.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/paper/hybrid_sheet.hpp"
@@ -25,9 +26,11 @@
 #include "crumple/pipeline/contacts.hpp"
 #include "crumple/pipeline/handle_rig.hpp"
 #include "crumple/pipeline/inspect.hpp"
+#include "crumple/pipeline/sound.hpp"
 #include "crumple/render/osmesa_renderer.hpp"
 #include "crumple/sim/colliders.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
+#include "crumple/sound/events.hpp"
 #include "crumple/tear/tear_atlas.hpp"
 #include "frame_output.hpp"
 #include "json_writer.hpp"
@@ -160,6 +163,16 @@ paper::InitialSheet hybridStartSheet(const io::SceneSpec& scene,
     }
   }
   return paper::makeFlatSheet(s.width, s.height, points, s.origin, u, v);
+}
+
+sound::EventParams eventParamsOf(const io::SoundSpec& s) {
+  sound::EventParams p;
+  p.gridSpacing = s.gridSpacing;
+  p.curvatureThreshold = s.curvatureThreshold;
+  p.maxDihedral = s.maxDihedral;
+  p.freeBorderRadius = s.freeBorderRadius;
+  p.minSlideSpeed = s.minSlideSpeed;
+  return p;
 }
 
 tear::TearingParams tearingParamsOf(const io::TearSpec& t) {
@@ -459,6 +472,13 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     report.tearingOn = true;
   }
 
+  // Sound events (issue 7): detected only for a scene with [sound].
+  std::optional<sound::EventDetector> soundEvents;
+  if (scene.sound.enabled) {
+    soundEvents.emplace(eventParamsOf(scene.sound));
+    report.soundOn = true;
+  }
+
   cache::CacheHeader header;
   header.fps = scene.fps;
   header.frameStart = scene.frameStart;
@@ -476,6 +496,11 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   for (const auto& h : rig.handles()) header.handleNames.push_back(h.name);
   header.extensions = lookBlocks;
   if (contactsOn) header.extensions.push_back(cache::encodeColliders(colliders.info()));
+  if (soundEvents) {
+    const sound::EventParams& p = soundEvents->params();
+    header.extensions.push_back(cache::encodeSoundSetup(
+        {p.gridSpacing, p.curvatureThreshold, p.maxDihedral, p.freeBorderRadius, p.minSlideSpeed}));
+  }
   cache::CacheWriter writer(report.cachePath, header);
 
   cache::FrameRecord record;
@@ -552,12 +577,12 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
       record.extensions.push_back(std::move(*motions));
     if (tearAtlasBlock) record.extensions.push_back(*tearAtlasBlock);
     record.tearCount = tearing ? static_cast<std::uint32_t>(tearing->startKinds().size()) : 0;
+    std::vector<cache::ContactRecord> touching;
     if (contactsOn) {
       // What the sheet touches at the end of the frame (the sound module's input).
       const auto& samples = hybrid            ? hybrid->contacts()
                             : carriedContacts ? *carriedContacts
                                               : elastic->contacts();
-      std::vector<cache::ContactRecord> touching;
       touching.reserve(samples.size());
       for (const auto& c : samples)
         touching.push_back({c.vertex, c.collider < 0 ? cache::kSelfContact : c.collider,
@@ -572,6 +597,43 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
         report.maxContactDepth = depth;
         report.maxContactDepthFrame = frame;
       }
+    }
+    if (soundEvents) {
+      // The frame's sound events and their resonators (thesis 4.3.2), in the cache.
+      const auto soundStart = Clock::now();
+      mesh::SheetMesh surface;
+      surface.pattern = record.pattern;
+      surface.positions = record.positions;
+      surface.triangles = record.triangles;
+      surface.regionOfTriangle = record.regionOfTriangle;
+      for (auto type : record.regionTypes)
+        surface.regionTypes.push_back(static_cast<mesh::RegionType>(type));
+      sound::SheetFrame input;
+      input.mesh = &surface;
+      input.rulings = record.rulings;
+      for (int v : record.handleVertices)
+        if (v >= 0) input.heldVertices.push_back(v);
+      for (const auto& c : touching) input.contacts.push_back({c.vertex, c.slideSpeed});
+      for (const auto& a : report.tearAdvances)
+        if (a.frame == frame)
+          input.tearAdvances.push_back({a.event.tear, a.event.from, a.event.to});
+      input.frameDuration = 1.0 / scene.fps;
+      std::vector<sound::SoundEvent> events;
+      try {
+        events = soundEvents->detect(input);
+      } catch (const std::exception& e) {
+        throw NumericalError("sound events", frame, e.what());
+      }
+      if (!events.empty()) {
+        std::vector<cache::SoundEventRecord> records;
+        for (const auto& e : events) {
+          records.push_back(soundEventRecord(e));
+          ++report.soundEvents[static_cast<std::size_t>(e.kind)];
+        }
+        record.extensions.push_back(cache::encodeSoundEvents(records));
+      }
+      report.stages["sound events"].totalMs += msSince(soundStart);
+      report.stages["sound events"].frames += 1;
     }
     auto start = Clock::now();
     writer.append(record);
@@ -876,6 +938,16 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     report.tearSegments = tearing->segments();
     report.tearStartKinds = tearing->startKinds();
   }
+  if (render && soundEvents) {
+    // `run`: the soundtrack too, before the movie that muxes it in.
+    SoundOptions soundOptions;
+    soundOptions.log = options.log;
+    soundOptions.interactive = options.interactive;
+    const SoundReport made = makeSound(report.cachePath, soundOptions);
+    report.soundPath = made.wavPath;
+    report.stages["sound"].totalMs += made.synthesisMs;
+    report.stages["sound"].frames += made.frames;
+  }
   if (renderer && report.framesRendered > 0)
     finishFrames(report.framesDir, FrameRange{std::max(range.first, scene.frameStart), range.last},
                  scene.fps, report.outDir, options.rendering, report.contactSheetPath,
@@ -997,7 +1069,14 @@ std::string summaryText(const ShotReport& r) {
     }
     out += line;
   }
+  if (r.soundOn) {
+    std::snprintf(line, sizeof line,
+                  "  sound    %ld crumpling, %ld friction, %ld tearing event(s)\n",
+                  r.soundEvents[0], r.soundEvents[1], r.soundEvents[2]);
+    out += line;
+  }
   out += "  cache:   " + r.cachePath + "\n";
+  if (!r.soundPath.empty()) out += "  sound:   " + r.soundPath + "\n";
   if (!r.framesDir.empty()) out += "  frames:  " + r.framesDir + "/\n";
   if (!r.contactSheetPath.empty()) out += "  contact sheet: " + r.contactSheetPath + "\n";
   if (!r.moviePath.empty()) out += "  movie:   " + r.moviePath + "\n";
@@ -1034,7 +1113,7 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
   j.key("contacts").value(!scene.colliders.empty());
   j.key("self_contact").value(r.selfContactSteps > 0);
   j.key("tearing").value(r.tearingOn);
-  j.key("sound").value(false);
+  j.key("sound").value(r.soundOn);
   j.key("render_osmesa").value(r.framesRendered > 0 && r.renderBackend == "osmesa");
   j.key("render_embree").value(r.framesRendered > 0 && r.renderBackend == "embree");
   j.endObject();
@@ -1057,6 +1136,15 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
         .value(static_cast<double>(r.contactSamples) / std::max(1, r.framesSimulated));
     j.key("max_depth_thicknesses").value(r.maxContactDepth);
     j.key("max_depth_frame").value(r.maxContactDepthFrame);
+    j.endObject();
+  }
+  if (r.soundOn) {
+    // Issue 7: the events in the cache, and the soundtrack `run` made.
+    j.key("sound").beginObject();
+    j.key("crumpling_events").value(static_cast<long long>(r.soundEvents[0]));
+    j.key("friction_events").value(static_cast<long long>(r.soundEvents[1]));
+    j.key("tearing_events").value(static_cast<long long>(r.soundEvents[2]));
+    j.key("wav").value(r.soundPath);  // empty: `simulate` (crumple sound makes it)
     j.endObject();
   }
   if (r.tearingOn) {

@@ -62,8 +62,8 @@ class SceneParser {
   SceneSpec parse() {
     const TableReader root(root_, "", file_);
     root.allowOnly({"scene", "sheet", "paper", "handles", "camera", "lights", "environment",
-                    "ground", "props", "colliders", "friction", "contact", "tear", "output", "sim",
-                    "model"});
+                    "ground", "props", "colliders", "friction", "contact", "tear", "sound",
+                    "output", "sim", "model"});
     // [scene] first: its `units` scales every length that follows.
     parseScene(root.subTable("scene"));
     const toml::table* sheet = root.subTable("sheet");
@@ -82,6 +82,7 @@ class SceneParser {
     parseColliders(root);
     parseContact(root.subTable("contact"));
     parseTear(root.subTable("tear"));
+    parseSound(root.subTable("sound"));
     parseOutput(root.subTable("output"));
     parseSim(root.subTable("sim"));
     parseModel(root.subTable("model"));
@@ -722,7 +723,7 @@ class SceneParser {
     const TableReader r(*table, "tear", file_);
     r.allowOnly({"enabled", "resistance", "tip_damage", "speed_m", "texel_mm", "fiber_size_mm",
                  "fiber_octaves", "fiber_anisotropy", "fiber_direction", "detail_blend",
-                 "stress_width_mm", "inward_angle_deg", "max_new_per_frame"});
+                 "stress_width_mm", "inward_angle_deg", "eps_a", "max_new_per_frame"});
     TearSpec& t = spec_.tear;
     t.enabled = r.boolean("enabled").value_or(true);
     if (auto v = r.number("resistance")) t.resistance = r.requireNonNegative("resistance", *v);
@@ -766,6 +767,47 @@ class SceneParser {
     if (auto v = r.integer("max_new_per_frame")) {
       if (*v < 0 || *v > 100) r.fail("max_new_per_frame", "must be in [0, 100]");
       t.maxNewPerFrame = static_cast<int>(*v);
+    }
+  }
+
+  // [sound]: the table's presence enables the sound events (issue 7).
+  void parseSound(const toml::table* table) {
+    if (!table) return;
+    const TableReader r(*table, "sound", file_);
+    r.allowOnly({"enabled", "grid_mm", "curvature_threshold", "a_max", "free_border_radius_cm",
+                 "min_slide_mm_s", "listener", "database", "channels", "sample_rate", "format"});
+    SoundSpec& s = spec_.sound;
+    s.enabled = r.boolean("enabled").value_or(true);
+    if (auto v = r.number("grid_mm")) {
+      s.gridSpacing = r.requirePositive("grid_mm", *v) * 1e-3;
+      if (s.gridSpacing < 1e-4) r.fail("grid_mm", "must be at least 0.1 mm");
+    }
+    if (auto v = r.number("curvature_threshold"))
+      s.curvatureThreshold = r.requirePositive("curvature_threshold", *v);
+    if (auto v = r.number("a_max")) {
+      if (!(*v > 0.0 && *v < std::numbers::pi)) r.fail("a_max", "must be in (0, pi) (rad)");
+      s.maxDihedral = *v;
+    }
+    if (auto v = r.number("free_border_radius_cm"))
+      s.freeBorderRadius = r.requirePositive("free_border_radius_cm", *v) * 1e-2;
+    if (auto v = r.number("min_slide_mm_s"))
+      s.minSlideSpeed = r.requireNonNegative("min_slide_mm_s", *v) * 1e-3;
+    if (auto v = r.vec3("listener")) s.listener = *v * mpu();
+    if (auto d = r.string("database")) {
+      s.databaseLine = r.lineOf("database");
+      s.database = resolvePath(*d);
+    }
+    if (auto v = r.integer("channels")) {
+      if (*v != 1 && *v != 2) r.fail("channels", "must be 1 (mono) or 2 (stereo)");
+      s.channels = static_cast<int>(*v);
+    }
+    if (auto v = r.integer("sample_rate")) {
+      if (*v != 48000 && *v != 44100) r.fail("sample_rate", "must be 48000 or 44100");
+      s.sampleRate = static_cast<int>(*v);
+    }
+    if (auto f = r.string("format")) {
+      if (*f != "pcm24" && *f != "float") r.fail("format", "must be \"pcm24\" or \"float\"");
+      s.floatSamples = *f == "float";
     }
   }
 

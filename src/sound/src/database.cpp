@@ -6,7 +6,9 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <numbers>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include "crumple/core/error.hpp"
@@ -160,6 +162,71 @@ const SoundCell* SoundDatabase::crumplingCell(double ruling, double border) cons
 
 const SoundCell* SoundDatabase::frictionCell(double ruling, double border) const {
   return nearest(ruling, border, false);
+}
+
+namespace {
+
+// Band-limited resampling: a Blackman-windowed sinc of kTaps zero crossings
+// either side, its cutoff at the lower of the two Nyquist frequencies.
+std::vector<float> resampleClip(const std::vector<float>& in, int from, int to) {
+  constexpr int kTaps = 24;
+  const double step = static_cast<double>(from) / to;  // input samples per output sample
+  const double cutoff = std::min(1.0, 1.0 / step);     // of the input's Nyquist
+  const auto n = static_cast<std::int64_t>(std::ceil(static_cast<double>(in.size()) / step));
+  std::vector<float> out(static_cast<std::size_t>(n));
+  const double reach = kTaps / cutoff;
+  for (std::int64_t i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) * step;
+    const auto j0 = static_cast<std::int64_t>(std::ceil(t - reach));
+    const auto j1 = static_cast<std::int64_t>(std::floor(t + reach));
+    double sum = 0.0;
+    for (std::int64_t j = std::max<std::int64_t>(0, j0);
+         j <= std::min<std::int64_t>(static_cast<std::int64_t>(in.size()) - 1, j1); ++j) {
+      const double x = (t - static_cast<double>(j)) * cutoff;
+      const double sinc = x == 0.0 ? 1.0 : std::sin(std::numbers::pi * x) / (std::numbers::pi * x);
+      const double u = (t - static_cast<double>(j)) / reach;  // in [-1, 1]
+      const double window =
+          0.42 + 0.5 * std::cos(std::numbers::pi * u) + 0.08 * std::cos(2.0 * std::numbers::pi * u);
+      sum += in[static_cast<std::size_t>(j)] * cutoff * sinc * window;
+    }
+    out[static_cast<std::size_t>(i)] = static_cast<float>(sum);
+  }
+  return out;
+}
+
+// A power spectrum's bins at another rate: bin k of the new one at
+// frequency k to / M, read from the old one by linear interpolation (zero
+// above its Nyquist frequency).
+std::vector<float> respectrum(const std::vector<float>& in, int from, int to) {
+  const std::size_t bins = in.size();
+  std::vector<float> out(bins, 0.0f);
+  for (std::size_t k = 0; k < bins; ++k) {
+    const double at = static_cast<double>(k) * to / from;  // in the old bins
+    const auto k0 = static_cast<std::size_t>(std::floor(at));
+    if (k0 + 1 >= bins) {
+      if (k0 + 1 == bins) out[k] = in[k0];
+      continue;
+    }
+    const double w = at - static_cast<double>(k0);
+    out[k] = static_cast<float>((1.0 - w) * in[k0] + w * in[k0 + 1]);
+  }
+  return out;
+}
+
+}  // namespace
+
+SoundDatabase SoundDatabase::resampledTo(int rate) const {
+  if (!supportedSampleRate(rate))
+    throw std::invalid_argument("SoundDatabase::resampledTo: " + std::to_string(rate) +
+                                " Hz is not a supported rate");
+  if (rate == rate_) return *this;
+  SoundDatabase out = *this;
+  out.rate_ = rate;
+  for (auto& cell : out.cells_) {
+    for (auto& clip : cell.clips) clip = resampleClip(clip, rate_, rate);
+    for (auto& spectrum : cell.spectra) spectrum = respectrum(spectrum, rate_, rate);
+  }
+  return out;
 }
 
 }  // namespace crumple::sound

@@ -1,6 +1,7 @@
 #pragma once
 // One shot, end to end (DESIGN.md "One shot, end to end"): scene + handle
 // tracks -> elastic sheet, frame by frame -> .pcache; and cache -> frames.
+#include <array>
 #include <cstdint>
 #include <cstdio>
 #include <map>
@@ -105,6 +106,11 @@ struct ShotReport {
   int tearHandoverFrame = -1;
   double tearMs = 0.0;      // candidates, Griffith tests, cuts, detail paths, baking (wall time)
   double tearBakeMs = 0.0;  // of which baking the tear textures
+  // Sound (issue 7): whether events were detected, how many of each kind
+  // (crumpling, friction, tearing), and the soundtrack `run` wrote.
+  bool soundOn = false;
+  std::array<long, 3> soundEvents{};
+  std::string soundPath;
   std::size_t vertices = 0;
   std::size_t triangles = 0;
   double maxHandleError = 0.0;

@@ -176,6 +176,24 @@ struct TearSpec {
   double epsA = 0.1;  // rad: a tear turning more at a former tip may branch there (Fig. 3.20)
 };
 
+// [sound]: the soundtrack (issue 7; thesis Chapter 4). Off unless the table
+// is present (or enabled = true): `simulate` then detects the sound events
+// and stores them in the cache, `run` also writes sound.wav.
+struct SoundSpec {
+  bool enabled = false;
+  double gridSpacing = 0.01;        // m (grid_mm): the curvature grid's step (Fig. 4.10)
+  double curvatureThreshold = 5.0;  // 1/m: |H_t - H_{t-1}| of a crumpling event's grid points
+  double maxDihedral = 0.5;         // a_max (rad): a ridge stops vibrations (4.3.2)
+  double freeBorderRadius = 1.0;    // m (free_border_radius_cm): bent more, a border is free
+  double minSlideSpeed = 0.01;      // m/s (min_slide_mm_s): slower contacts are silent
+  std::optional<Vec3> listener;     // world (m); default: the camera
+  std::string database;             // sound database folder, resolved; empty: the default
+  long databaseLine = 0;            // scene file line of `database` (for errors)
+  int channels = 2;                 // 1 or 2
+  int sampleRate = 48000;           // 48000 or 44100
+  bool floatSamples = false;        // 32-bit float instead of 24-bit PCM
+};
+
 struct GroundSpec {
   bool enabled = false;
   double height = 0.0;  // m, world Y of the plane
@@ -253,6 +271,7 @@ struct SceneSpec {
   std::map<std::string, double> friction;
   ContactSpec contact;  // [contact]
   TearSpec tear;        // [tear]
+  SoundSpec sound;      // [sound]
   OutputSpec output;
   SimSpec sim;
   ModelSpec model;

@@ -61,6 +61,12 @@ class SoundDatabase {
   const SoundCell* crumplingCell(double ruling, double border) const;
   const SoundCell* frictionCell(double ruling, double border) const;
 
+  // The database at another rate (48000 <-> 44100): clips resampled with a
+  // windowed sinc below the lower Nyquist frequency, spectra read at the
+  // same frequencies (the same fft_size). Throws std::invalid_argument for
+  // an unsupported rate. The same database when the rate is its own.
+  SoundDatabase resampledTo(int rate) const;
+
  private:
   const SoundCell* nearest(double ruling, double border, bool clips) const;
   int rate_ = 0;

@@ -1,0 +1,155 @@
+// The SNDS and SEVT extension sub-blocks. Byte layout: docs/PCACHE.md
+// ("Sub-blocks written by crumple").
+#include "crumple/exporters/pcache_sound.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "block_reader.hpp"
+#include "byte_encoder.hpp"
+
+namespace crumple::cache {
+namespace {
+
+using detail::Bytes;
+using detail::Encoder;
+using detail::findOneBlock;
+using Reader = detail::SubBlockReader;
+
+constexpr std::size_t kSetupBytes = 5 * 8;
+constexpr std::size_t kResonatorBytes = 10 * 8;
+constexpr std::size_t kMinEventBytes = 1 + 4 + 7 * 8 + 4;
+
+bool finite(const Vec3& v) { return v.allFinite(); }
+bool finiteNonNegative(double v) { return std::isfinite(v) && v >= 0.0; }
+
+std::string setupProblem(const SoundSetupRecord& s) {
+  if (!(std::isfinite(s.gridSpacing) && s.gridSpacing > 0.0)) return "grid spacing is not positive";
+  if (!(std::isfinite(s.curvatureThreshold) && s.curvatureThreshold > 0.0))
+    return "curvature threshold is not positive";
+  if (!(std::isfinite(s.maxDihedral) && s.maxDihedral > 0.0)) return "a_max is not positive";
+  if (!(std::isfinite(s.freeBorderRadius) && s.freeBorderRadius > 0.0))
+    return "free border radius is not positive";
+  if (!finiteNonNegative(s.minSlideSpeed)) return "minimum slide speed is negative";
+  return {};
+}
+
+std::string resonatorProblem(const ResonatorRecord& r) {
+  if (!finiteNonNegative(r.ruling) || !finiteNonNegative(r.border) || !finiteNonNegative(r.area) ||
+      !finiteNonNegative(r.radius))
+    return "a size (l_r, l_c, area, radius) is negative or not finite";
+  if (!finite(r.centre) || !finite(r.normal)) return "a non-finite centre or normal";
+  return {};
+}
+
+std::string eventProblem(const SoundEventRecord& e) {
+  if (e.kind > 2) return "kind " + std::to_string(e.kind) + " is not 0, 1 or 2";
+  if (e.tear < -1) return "tear " + std::to_string(e.tear) + " is below -1";
+  if (!finiteNonNegative(e.amplitude)) return "amplitude is negative or not finite";
+  if (!finite(e.position) || !finite(e.normal)) return "a non-finite position or normal";
+  return {};
+}
+
+void vec3(Encoder& w, const Vec3& v) {
+  for (int k = 0; k < 3; ++k) w.f64(v[k]);
+}
+Vec3 vec3(Reader& r, const char* what) {
+  Vec3 v;
+  for (int k = 0; k < 3; ++k) v[k] = r.f64(what);
+  return v;
+}
+
+}  // namespace
+
+ExtensionBlock encodeSoundSetup(const SoundSetupRecord& s) {
+  if (const auto problem = setupProblem(s); !problem.empty())
+    throw std::invalid_argument("encodeSoundSetup: " + problem);
+  Bytes bytes;
+  Encoder w(bytes);
+  w.f64(s.gridSpacing);
+  w.f64(s.curvatureThreshold);
+  w.f64(s.maxDihedral);
+  w.f64(s.freeBorderRadius);
+  w.f64(s.minSlideSpeed);
+  return {kSoundSetupTag, std::move(bytes)};
+}
+
+ExtensionBlock encodeSoundEvents(const std::vector<SoundEventRecord>& events) {
+  Bytes bytes;
+  Encoder w(bytes);
+  w.count(events.size(), "sound events");
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    const auto& e = events[i];
+    if (const auto problem = eventProblem(e); !problem.empty())
+      throw std::invalid_argument("encodeSoundEvents: event " + std::to_string(i) + ": " + problem);
+    w.u8(e.kind);
+    w.i32(e.tear);
+    w.f64(e.amplitude);
+    vec3(w, e.position);
+    vec3(w, e.normal);
+    w.count(e.resonators.size(), "resonators");
+    for (std::size_t k = 0; k < e.resonators.size(); ++k) {
+      const auto& r = e.resonators[k];
+      if (const auto problem = resonatorProblem(r); !problem.empty())
+        throw std::invalid_argument("encodeSoundEvents: event " + std::to_string(i) +
+                                    ", resonator " + std::to_string(k) + ": " + problem);
+      w.f64(r.ruling);
+      w.f64(r.border);
+      w.f64(r.area);
+      vec3(w, r.centre);
+      vec3(w, r.normal);
+      w.f64(r.radius);
+    }
+  }
+  return {kSoundEventsTag, std::move(bytes)};
+}
+
+std::optional<SoundSetupRecord> decodeSoundSetup(const std::vector<ExtensionBlock>& headerBlocks) {
+  const ExtensionBlock* block = findOneBlock(headerBlocks, kSoundSetupTag);
+  if (!block) return std::nullopt;
+  Reader r(block->data, "SNDS");
+  if (r.remaining() < kSetupBytes) r.fail("truncated");
+  SoundSetupRecord s;
+  s.gridSpacing = r.f64("grid spacing");
+  s.curvatureThreshold = r.f64("curvature threshold");
+  s.maxDihedral = r.f64("a_max");
+  s.freeBorderRadius = r.f64("free border radius");
+  s.minSlideSpeed = r.f64("minimum slide speed");
+  if (const auto problem = setupProblem(s); !problem.empty()) r.fail(problem);
+  r.expectEnd();
+  return s;
+}
+
+std::optional<std::vector<SoundEventRecord>> decodeSoundEvents(
+    const std::vector<ExtensionBlock>& frameBlocks) {
+  const ExtensionBlock* block = findOneBlock(frameBlocks, kSoundEventsTag);
+  if (!block) return std::nullopt;
+  Reader r(block->data, "SEVT");
+  std::vector<SoundEventRecord> events(r.count(kMinEventBytes, "event count"));
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    auto& e = events[i];
+    r.at("event", i);
+    e.kind = r.u8("kind");
+    e.tear = r.i32("tear");
+    e.amplitude = r.f64("amplitude");
+    e.position = vec3(r, "position");
+    e.normal = vec3(r, "normal");
+    if (const auto problem = eventProblem(e); !problem.empty()) r.fail(problem);
+    e.resonators.resize(r.count(kResonatorBytes, "resonator count"));
+    for (auto& q : e.resonators) {
+      q.ruling = r.f64("l_r");
+      q.border = r.f64("l_c");
+      q.area = r.f64("area");
+      q.centre = vec3(r, "centre");
+      q.normal = vec3(r, "normal");
+      q.radius = r.f64("radius");
+      if (const auto problem = resonatorProblem(q); !problem.empty()) r.fail(problem);
+    }
+  }
+  r.expectEnd();
+  return events;
+}
+
+}  // namespace crumple::cache

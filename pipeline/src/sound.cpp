@@ -1,0 +1,225 @@
+// `crumple sound`: the soundtrack from a cache (docs/SOUND.md "crumple sound").
+#include "crumple/pipeline/sound.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+
+#include "crumple/core/error.hpp"
+#include "crumple/core/progress.hpp"
+#include "crumple/exporters/pcache.hpp"
+#include "crumple/exporters/png.hpp"
+#include "crumple/sound/database.hpp"
+#include "crumple/sound/soundtrack.hpp"
+#include "crumple/sound/spectrogram.hpp"
+#include "crumple/sound/wav.hpp"
+
+namespace crumple::pipeline {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kPeakDbfs = -1.0;  // the normalised mix's peak
+
+cache::ResonatorRecord resonatorRecord(const sound::Resonator& r) {
+  return {r.ruling, r.border, r.area, r.centre, r.normal, r.radius};
+}
+sound::Resonator resonatorOf(const cache::ResonatorRecord& r) {
+  sound::Resonator q;
+  q.ruling = r.ruling;
+  q.border = r.border;
+  q.area = r.area;
+  q.centre = r.centre;
+  q.normal = r.normal;
+  q.radius = r.radius;
+  return q;
+}
+
+const char* kindName(std::uint8_t kind) {
+  return kind == 0 ? "crumpling" : kind == 1 ? "friction" : "tearing";
+}
+
+// The table the sources are mirrored in (4.3.4): the scene's first plane
+// collider, else its ground.
+std::optional<sound::ReflectingPlane> tableOf(const io::SceneSpec& scene) {
+  for (const auto& c : scene.colliders)
+    if (c.kind == io::ColliderSpec::Kind::Plane && c.node.empty())
+      return sound::ReflectingPlane{c.position, c.normal};
+  if (scene.ground.enabled)
+    return sound::ReflectingPlane{Vec3(0.0, scene.ground.height, 0.0), Vec3::UnitY()};
+  return std::nullopt;
+}
+
+// Atomically: PATH.tmp then rename.
+void renameInto(const fs::path& tmp, const fs::path& path) {
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) throw InputError(path.string(), "cannot write: " + ec.message());
+}
+
+}  // namespace
+
+sound::SoundEvent soundEventOf(const cache::SoundEventRecord& r) {
+  sound::SoundEvent e;
+  e.kind = static_cast<sound::EventKind>(r.kind);
+  e.tear = r.tear;
+  e.amplitude = r.amplitude;
+  e.position = r.position;
+  e.normal = r.normal;
+  for (const auto& q : r.resonators) e.resonators.push_back(resonatorOf(q));
+  return e;
+}
+
+cache::SoundEventRecord soundEventRecord(const sound::SoundEvent& e) {
+  cache::SoundEventRecord r;
+  r.kind = static_cast<std::uint8_t>(e.kind);
+  r.tear = e.tear;
+  r.amplitude = e.amplitude;
+  r.position = e.position;
+  r.normal = e.normal;
+  for (const auto& q : e.resonators) r.resonators.push_back(resonatorRecord(q));
+  return r;
+}
+
+std::string defaultSoundDatabase() {
+  if (const char* env = std::getenv("CRUMPLE_ASSETS"); env && *env) {
+    const fs::path dir = fs::path(env) / "sound" / "default";
+    if (fs::exists(dir / "index.toml")) return dir.string();
+  }
+  return (fs::path(CRUMPLE_SOURCE_ASSETS) / "sound" / "default").string();
+}
+
+SoundReport makeSound(const std::string& cachePath, const SoundOptions& options) {
+  const cache::CacheReader reader(cachePath);
+  if (reader.frameCount() == 0) throw InputError(cachePath, "the cache holds no frames");
+  const auto& header = reader.header();
+  if (!cache::decodeSoundSetup(header.extensions))
+    throw InputError(cachePath,
+                     "the cache has no sound events: its scene had no [sound] table when it was "
+                     "simulated (add [sound] to the scene and run crumple simulate again)");
+  const io::SceneSpec scene =
+      io::parseScene(header.sceneText, header.sceneFile + " (in " + cachePath + ")",
+                     fs::path(header.sceneFile).parent_path().string(),
+                     /*checkFiles=*/false);
+  SoundReport report;
+  report.sampleRate = options.sampleRate.value_or(scene.sound.sampleRate);
+  if (!sound::supportedSampleRate(report.sampleRate))
+    throw InputError("--rate", std::to_string(report.sampleRate) + " Hz: 48000 or 44100");
+  report.channels = options.channels.value_or(scene.sound.channels);
+  if (report.channels != 1 && report.channels != 2)
+    throw InputError("--channels", std::to_string(report.channels) + ": 1 (mono) or 2 (stereo)");
+  const bool floatSamples = options.floatSamples.value_or(scene.sound.floatSamples);
+  report.databasePath = !options.database.empty()       ? options.database
+                        : !scene.sound.database.empty() ? scene.sound.database
+                                                        : defaultSoundDatabase();
+  report.wavPath = !options.out.empty()
+                       ? options.out
+                       : (fs::path(cachePath).parent_path() / "sound.wav").string();
+  if (options.gainDb && !std::isfinite(*options.gainDb))
+    throw InputError("--gain-db", "must be a finite number of dB");
+
+  const sound::SoundDatabase db =
+      sound::SoundDatabase::load(report.databasePath).resampledTo(report.sampleRate);
+
+  // The events, frame by frame, and where they are heard from.
+  report.frames = static_cast<int>(reader.frameCount());
+  std::vector<sound::FrameEvents> frames(reader.frameCount());
+  Progress progress("crumple sound (reading events)", static_cast<long>(reader.frameCount()),
+                    options.log, options.interactive);
+  for (std::size_t i = 0; i < reader.frameCount(); ++i) {
+    const cache::FrameRecord record = reader.readFrame(i);
+    sound::FrameEvents& f = frames[i];
+    f.listener = scene.sound.listener.value_or(record.camera.position);
+    f.right = record.camera.rotation * Vec3::UnitX();
+    if (const auto events = cache::decodeSoundEvents(record.extensions))
+      for (const auto& r : *events) {
+        f.events.push_back(soundEventOf(r));
+        switch (r.kind) {
+          case 0:
+            ++report.crumplingEvents;
+            for (const auto& q : r.resonators)
+              ++(q.border > 0.0 ? report.flapResonators : report.clacResonators);
+            break;
+          case 1:
+            ++report.frictionEvents;
+            for (const auto& q : r.resonators)
+              ++(q.border > 0.0 ? report.freeFriction : report.constrainedFriction);
+            break;
+          default:
+            ++report.tearingEvents;
+        }
+      }
+    progress.update(static_cast<long>(i + 1));
+  }
+  progress.finish();
+
+  const sound::Timeline timeline(report.sampleRate, header.fps, report.frames);
+  sound::SoundtrackSettings settings;
+  settings.channels = report.channels;
+  settings.table = tableOf(scene);
+  settings.seed = header.seed;
+  const auto start = std::chrono::steady_clock::now();
+  sound::Audio audio = sound::renderSoundtrack(db, timeline, frames, settings);
+  report.synthesisMs =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double peak = sound::peakLevel(audio);
+  report.gainDb = options.gainDb ? *options.gainDb
+                  : peak > 0.0   ? kPeakDbfs - 20.0 * std::log10(peak)
+                                 : 0.0;
+  const auto gain = static_cast<float>(std::pow(10.0, report.gainDb / 20.0));
+  for (auto& channel : audio.channels)
+    for (float& v : channel) v *= gain;
+  report.peak = sound::peakLevel(audio);
+  report.samples = static_cast<std::int64_t>(audio.sampleCount());
+  report.seconds = static_cast<double>(report.samples) / report.sampleRate;
+
+  const fs::path wav(report.wavPath);
+  if (wav.has_parent_path()) fs::create_directories(wav.parent_path());
+  const fs::path wavTmp = wav.string() + ".tmp";
+  try {
+    report.clipped = sound::writeWav(
+        wavTmp, audio, floatSamples ? sound::SampleFormat::Float32 : sound::SampleFormat::Pcm24);
+  } catch (const std::runtime_error& e) {
+    throw InputError(report.wavPath, e.what());
+  }
+  renameInto(wavTmp, wav);
+  if (options.spectrogram) {
+    fs::path png = wav;
+    png.replace_extension(".png");
+    exporters::writePng(png.string(), sound::spectrogram(audio));
+    report.spectrogramPath = png.string();
+  }
+  return report;
+}
+
+std::string eventTimeline(const std::string& cachePath) {
+  const cache::CacheReader reader(cachePath);
+  if (!cache::decodeSoundSetup(reader.header().extensions))
+    throw InputError(cachePath, "the cache has no sound events (its scene had no [sound] table)");
+  std::ostringstream out;
+  out << "# frame time_s kind amplitude x y z | resonators: l_r_cm l_c_cm area_cm2 "
+         "(clac/flap for crumpling)\n";
+  char line[256];
+  for (std::size_t i = 0; i < reader.frameCount(); ++i) {
+    const cache::FrameRecord record = reader.readFrame(i);
+    const auto events = cache::decodeSoundEvents(record.extensions);
+    if (!events) continue;
+    for (const auto& e : *events) {
+      std::snprintf(line, sizeof line, "%d %.4f %s %.4g %.3f %.3f %.3f |", record.frame,
+                    record.time, kindName(e.kind), e.amplitude, e.position.x(), e.position.y(),
+                    e.position.z());
+      out << line;
+      for (const auto& q : e.resonators) {
+        std::snprintf(line, sizeof line, " %.1f %.1f %.0f%s", 100.0 * q.ruling, 100.0 * q.border,
+                      1e4 * q.area, e.kind == 0 ? (q.border > 0.0 ? " flap" : " clac") : "");
+        out << line << ";";
+      }
+      out << "\n";
+    }
+  }
+  return out.str();
+}
+
+}  // namespace crumple::pipeline

@@ -1,0 +1,125 @@
+#pragma once
+// Sound-source events and their resonators (thesis 4.3.2; issue 7, items
+// 1-2). Every simulated frame, the sheet is searched for
+// - crumpling events: connected patches of a regular grid, laid on the
+//   pattern and carried onto the surface (Fig. 4.10), whose mean curvature
+//   changed sign by more than a threshold since the previous frame;
+// - friction events: connected sets of vertices touching something, with
+//   their mean sliding speed;
+// - tearing events: tear tips that advanced, with their speed (4.4).
+// Each crumpling or friction event sets resonators vibrating: the sheet
+// around it up to the ridges (dihedral angle above a_max), the free
+// borders, the held points and the contacts (Fig. 4.11), one resonator per
+// region it reaches, each sized by l_r (its mean ruling length) and l_c
+// (its free curved border length; 0: constrained) (Fig. 4.12).
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "crumple/core/types.hpp"
+#include "crumple/mesh/sheet_mesh.hpp"
+
+namespace crumple::sound {
+
+struct EventParams {
+  double gridSpacing = 0.01;  // m: the curvature grid's step in the pattern (Fig. 4.10)
+  // Grids larger than this many points get a larger step (a poster).
+  int maxGridPoints = 40000;
+  // The curvature change |H_t - H_{t-1}| (1/m) a grid point must exceed
+  // (thesis 4.3.2's threshold against small instabilities).
+  double curvatureThreshold = 5.0;
+  double maxDihedral = 0.5;  // a_max (rad): a ridge stops vibrations (thesis 4.3.2)
+  // A sheet border bent along its length to a radius below this (m), and
+  // neither held nor touching, is a free curved border (Fig. 4.8): a
+  // curved region's borders across its rulings, not its straight ends.
+  double freeBorderRadius = 1.0;
+  double minSlideSpeed = 0.01;  // m/s: slower contacts make no friction event
+};
+
+// A resonator (thesis 4.3.2-4.3.4): its size parameters, and the disk that
+// radiates its sound (a dipole at its centre, along its mean normal, of its
+// area).
+struct Resonator {
+  double ruling = 0.0;  // l_r (m): mean ruling length
+  double border = 0.0;  // l_c (m): free curved border length; 0: constrained
+  double area = 0.0;    // m^2
+  Vec3 centre = Vec3::Zero();
+  Vec3 normal = Vec3::UnitY();
+  double radius = 0.0;  // m: sqrt(area / pi)
+  bool constrained() const { return border == 0.0; }
+};
+
+enum class EventKind : std::uint8_t { Crumpling = 0, Friction = 1, Tearing = 2 };
+
+struct SoundEvent {
+  EventKind kind = EventKind::Crumpling;
+  // Crumpling: the sum of the curvature changes, each times its grid cell's
+  // area (m; grid-independent). Friction: the mean sliding speed (m/s).
+  // Tearing: the tip's speed (m/s).
+  double amplitude = 0.0;
+  Vec3 position = Vec3::Zero();       // where it happened
+  Vec3 normal = Vec3::UnitY();        // the sheet's normal there (tearing)
+  int tear = -1;                      // tearing: the tear
+  std::vector<Resonator> resonators;  // crumpling and friction
+};
+
+// One frame of the simulated sheet as the events see it.
+struct SheetFrame {
+  const mesh::SheetMesh* mesh = nullptr;  // positions, pattern, triangles, regions
+  // The crumpling model's rulings (vertex pairs of the mesh); empty otherwise.
+  std::vector<std::array<int, 2>> rulings;
+  std::vector<int> heldVertices;  // handles holding the sheet
+  struct Touch {
+    int vertex = -1;
+    double slideSpeed = 0.0;  // m/s
+  };
+  std::vector<Touch> contacts;
+  struct TipAdvance {
+    int tear = -1;
+    Vec2 from = Vec2::Zero();  // pattern (m)
+    Vec2 to = Vec2::Zero();
+  };
+  std::vector<TipAdvance> tearAdvances;  // made since the previous frame
+  double frameDuration = 0.0;            // s since the previous frame (tip speeds)
+};
+
+// The frame-to-frame detector: keeps the curvature grid's previous values.
+class EventDetector {
+ public:
+  // Throws std::invalid_argument for a non-positive step, threshold,
+  // radius or a_max outside (0, pi).
+  explicit EventDetector(const EventParams& params = {});
+
+  // The events of this frame, in a fixed order (crumpling, friction,
+  // tearing; each by position in the grid, vertex or tear): deterministic.
+  // The first frame has no crumpling events (no previous curvature).
+  // Throws std::invalid_argument for a malformed frame.
+  std::vector<SoundEvent> detect(const SheetFrame& frame);
+
+  const EventParams& params() const { return params_; }
+  // The grid's step and size, fixed at the first frame.
+  double gridStep() const { return step_; }
+  int gridPoints() const { return nx_ * ny_; }
+  // Mean curvature (1/m) at each grid point after the last detect(), row by
+  // row from the pattern's lower left; nullopt where it is undefined (off
+  // the sheet, across a tear, at its border).
+  const std::vector<std::optional<double>>& curvature() const { return previous_; }
+
+ private:
+  EventParams params_;
+  double step_ = 0.0;
+  Vec2 origin_ = Vec2::Zero();
+  int nx_ = 0, ny_ = 0;
+  std::vector<std::optional<double>> previous_;
+};
+
+// Thesis 4.3.2 "Resonator estimation" on its own: the resonators that
+// `seedTriangles` set vibrating. `blocked[v]` marks held and touching
+// vertices; an edge with such an end, a dihedral angle above a_max or on the
+// sheet's border stops the growth.
+std::vector<Resonator> findResonators(const SheetFrame& frame,
+                                      const std::vector<int>& seedTriangles,
+                                      const std::vector<char>& blocked, const EventParams& params);
+
+}  // namespace crumple::sound

@@ -1,0 +1,239 @@
+// Thesis Algorithm 4: a shot's events into a soundtrack (docs/SOUND.md
+// "The soundtrack").
+#include "crumple/sound/soundtrack.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <span>
+#include <stdexcept>
+#include <string>
+
+#include "crumple/core/rng.hpp"
+#include "crumple/sound/crumpling_synth.hpp"
+#include "crumple/sound/friction_synth.hpp"
+
+namespace crumple::sound {
+namespace {
+
+constexpr double kMinDistance = 0.01;  // m: a source nearer the ear than this is not heard
+
+std::vector<Vec3> earsOf(const FrameEvents& f, const SoundtrackSettings& s) {
+  if (s.channels == 1) return {f.listener};
+  const Vec3 right = f.right.norm() > 0.0 ? Vec3(f.right.normalized()) : Vec3::UnitX();
+  return {f.listener - 0.5 * s.earSpacing * right, f.listener + 0.5 * s.earSpacing * right};
+}
+
+// The dipole's response at an ear, its gains relative to the reference
+// disk's at 1 m; nullopt when the ear is at the source.
+std::optional<DipoleResponse> responseAt(const Vec3& position, const Vec3& normal, double radius,
+                                         const Vec3& ear, const SoundtrackSettings& s) {
+  if ((ear - position).norm() < kMinDistance) return std::nullopt;
+  const ReflectingPlane* table = s.table ? &*s.table : nullptr;
+  const Vec3 n = normal.norm() > 0.0 ? Vec3(normal.normalized()) : Vec3::UnitY();
+  DipoleResponse r = dipoleResponse({position, n, radius}, ear, table);
+  const double unit = 1.0 / std::pow(s.referenceRadius, 3);
+  r.direct.gain *= unit;
+  if (r.image) r.image->gain *= unit;
+  return r;
+}
+
+// Each resonator's share of its event: the event's power split by area.
+double areaShare(const SoundEvent& e, const Resonator& r) {
+  double total = 0.0;
+  for (const auto& q : e.resonators) total += q.area;
+  return total > 0.0 ? r.area / total : 0.0;
+}
+
+}  // namespace
+
+double peakLevel(const Audio& audio) {
+  double peak = 0.0;
+  for (const auto& c : audio.channels)
+    for (float v : c) peak = std::max(peak, static_cast<double>(std::abs(v)));
+  return peak;
+}
+
+Audio renderSoundtrack(const SoundDatabase& db, const Timeline& timeline,
+                       const std::vector<FrameEvents>& frames, const SoundtrackSettings& s,
+                       SoundtrackStats* statsOut) {
+  if (db.sampleRate() != timeline.sampleRate())
+    throw std::invalid_argument("renderSoundtrack: the database is at " +
+                                std::to_string(db.sampleRate()) + " Hz, the soundtrack at " +
+                                std::to_string(timeline.sampleRate()));
+  if (s.channels != 1 && s.channels != 2)
+    throw std::invalid_argument("renderSoundtrack: 1 or 2 channels, not " +
+                                std::to_string(s.channels));
+  SoundtrackStats stats;
+  const std::int64_t length = timeline.sampleCount();
+  const std::size_t frameCount =
+      std::min(frames.size(), static_cast<std::size_t>(timeline.frameCount()));
+  Audio audio;
+  audio.sampleRate = timeline.sampleRate();
+  audio.channels.assign(static_cast<std::size_t>(s.channels), {});
+
+  // Crumpling (4.3.3): each resonator's clip at the frame's sample, its
+  // variant drawn per resonator (the same for both ears).
+  std::int64_t clipId = 0;
+  for (std::size_t f = 0; f < frameCount; ++f) {
+    const std::vector<Vec3> ears = earsOf(frames[f], s);
+    const double time = timeline.timeOf(timeline.frameStart(static_cast<int>(f)));
+    for (const auto& e : frames[f].events) {
+      if (e.kind != EventKind::Crumpling) continue;
+      for (const auto& r : e.resonators) {
+        const std::int64_t id = clipId++;
+        const double amplitude =
+            s.crumplingGain * (e.amplitude / s.crumplingReference) * std::sqrt(areaShare(e, r));
+        for (std::size_t c = 0; c < ears.size(); ++c) {
+          const auto response = responseAt(r.centre, r.normal, r.radius, ears[c], s);
+          if (!response) {
+            ++stats.silentSources;
+            continue;
+          }
+          if (addCrumplingSound(db, {time, amplitude, r.ruling, r.border, *response}, timeline,
+                                s.seed, id, audio.channels[c]))
+            ++stats.crumplingClips;
+        }
+      }
+    }
+  }
+
+  // Friction (Algorithm 4): per frame and ear, the resonators' spectra
+  // weighted by their event's speed and area share and by the dipole's
+  // eq. (4.12) factor, summed; each noise block sounds the spectrum of its
+  // centre's time, interpolated between frames.
+  const int m = db.fftSize();
+  const std::size_t bins = static_cast<std::size_t>(m / 2 + 1);
+  std::vector<std::vector<std::vector<float>>> spectra(
+      frameCount, std::vector<std::vector<float>>(static_cast<std::size_t>(s.channels)));
+  bool anyFriction = false;
+  for (std::size_t f = 0; f < frameCount; ++f) {
+    const std::vector<Vec3> ears = earsOf(frames[f], s);
+    std::int64_t resonatorIndex = 0;
+    for (const auto& e : frames[f].events) {
+      if (e.kind != EventKind::Friction) continue;
+      for (const auto& r : e.resonators) {
+        const SoundCell* cell = db.frictionCell(r.ruling, r.border);
+        if (cell == nullptr) continue;
+        const CounterRng rng(s.seed, static_cast<std::int64_t>(f), RngPurpose::SoundVariant);
+        const auto& spectrum = cell->spectra[static_cast<std::size_t>(
+            rng.bits(static_cast<std::uint64_t>(resonatorIndex++)) % cell->spectra.size())];
+        const double weight =
+            s.frictionGain * (e.amplitude / s.frictionReference) * areaShare(e, r);
+        for (std::size_t c = 0; c < ears.size(); ++c) {
+          const auto response = responseAt(r.centre, r.normal, r.radius, ears[c], s);
+          if (!response) {
+            ++stats.silentSources;
+            continue;
+          }
+          const std::vector<float> factor = powerFactor(*response, m, timeline.sampleRate());
+          auto& sum = spectra[f][c];
+          if (sum.empty()) sum.assign(bins, 0.0f);
+          for (std::size_t k = 0; k < bins; ++k)
+            sum[k] += static_cast<float>(weight * spectrum[k] * factor[k]);
+          anyFriction = true;
+        }
+      }
+    }
+  }
+  if (anyFriction) {
+    const std::int64_t hop = m / 2;
+    // Blocks start one hop before the first sample, so that every sample
+    // lies under two windows.
+    const std::int64_t blocks = (length + hop) / hop + 1;
+    std::vector<float> power(bins);
+    for (std::size_t c = 0; c < static_cast<std::size_t>(s.channels); ++c) {
+      FrictionSynth synth(m, s.seed);
+      std::vector<float> out;
+      for (std::int64_t b = 0; b < blocks; ++b) {
+        const double centre = timeline.timeOf(b * hop - hop + m / 2);
+        const double at =
+            std::clamp(centre * timeline.fps(), 0.0, static_cast<double>(frameCount - 1));
+        const std::size_t f0 = static_cast<std::size_t>(std::floor(at));
+        const std::size_t f1 = std::min(f0 + 1, frameCount - 1);
+        const double w = at - static_cast<double>(f0);
+        const auto& p0 = spectra[f0][c];
+        const auto& p1 = spectra[f1][c];
+        if (p0.empty() && p1.empty()) continue;
+        bool silent = true;
+        for (std::size_t k = 0; k < bins; ++k) {
+          power[k] = static_cast<float>((p0.empty() ? 0.0 : (1.0 - w) * p0[k]) +
+                                        (p1.empty() ? 0.0 : w * p1[k]));
+          silent = silent && power[k] == 0.0f;
+        }
+        if (silent) continue;
+        synth.addBlock(b, power, out);
+        ++stats.frictionBlocks;
+      }
+      auto& channel = audio.channels[c];
+      channel.resize(std::max(channel.size(), out.size() > static_cast<std::size_t>(hop)
+                                                  ? out.size() - static_cast<std::size_t>(hop)
+                                                  : 0),
+                     0.0f);
+      for (std::size_t i = static_cast<std::size_t>(hop); i < out.size(); ++i)
+        channel[i - static_cast<std::size_t>(hop)] += out[i];
+    }
+  }
+
+  // Tearing (4.4.1): each tear's crackle at its tip's speed, which moves
+  // linearly between the middles of the frames it advanced in; spatialised
+  // frame by frame as a small disk at the tip.
+  std::map<int, std::vector<std::pair<std::size_t, const SoundEvent*>>> tears;
+  for (std::size_t f = 0; f < frameCount; ++f)
+    for (const auto& e : frames[f].events)
+      if (e.kind == EventKind::Tearing) tears[e.tear].push_back({f, &e});
+  const double frameTime = 1.0 / timeline.fps();
+  for (const auto& [tear, advances] : tears) {
+    // The speed at the middle of each frame interval (f - 1, f].
+    std::vector<double> speedAt(frameCount + 1, 0.0);
+    for (const auto& [f, e] : advances) speedAt[f] = e->amplitude;
+    const auto speed = [&](double t) {
+      const double u = t / frameTime + 0.5;  // frame f's advance peaks at t = (f - 0.5) / fps
+      if (u < 0.0) return 0.0;
+      const std::size_t f0 = static_cast<std::size_t>(std::floor(u));
+      if (f0 >= frameCount) return 0.0;
+      const double w = u - static_cast<double>(f0);
+      return (1.0 - w) * speedAt[f0] + w * (f0 + 1 < frameCount ? speedAt[f0 + 1] : 0.0);
+    };
+    // The frames over which the crackle sounds: from half a frame before
+    // the first advance to half a frame after the last.
+    const std::size_t first = advances.front().first;
+    const std::size_t last = advances.back().first;
+    for (std::size_t c = 0; c < static_cast<std::size_t>(s.channels); ++c) {
+      TearingNoise noise(s.seed, tear, s.tearing);
+      std::vector<float> track;  // the crackle at the tip, by output sample
+      for (std::size_t f = first > 0 ? first - 1 : 0; f <= std::min(last + 1, frameCount - 1);
+           ++f) {
+        // Samples [start, end) around frame f's advance: (f - 1, f].
+        const std::int64_t start = std::max<std::int64_t>(
+            0, timeline.sampleAt((static_cast<double>(f) - 1.0) * frameTime));
+        const std::int64_t end =
+            std::min<std::int64_t>(length, timeline.sampleAt(static_cast<double>(f) * frameTime));
+        if (end <= start) continue;
+        std::vector<double> speeds(static_cast<std::size_t>(end - start));
+        for (std::int64_t i = start; i < end; ++i)
+          speeds[static_cast<std::size_t>(i - start)] = speed(timeline.timeOf(i));
+        noise.add(start, speeds, track);
+        const std::span<const float> chunk(track.data() + start, speeds.size());
+        stats.tearingSamples += static_cast<long>(speeds.size());
+        // Where the tip was: this frame's event, else the nearest one.
+        const SoundEvent* at = advances.front().second;
+        for (const auto& [g, e] : advances)
+          if (g <= f + 1) at = e;
+        const std::vector<Vec3> ears = earsOf(frames[f], s);
+        const auto response = responseAt(at->position, at->normal, s.tearingRadius, ears[c], s);
+        if (!response) {
+          ++stats.silentSources;
+          continue;
+        }
+        addClip(chunk, *response, timeline.sampleRate(), start, audio.channels[c]);
+      }
+    }
+  }
+
+  for (auto& channel : audio.channels) channel.resize(static_cast<std::size_t>(length), 0.0f);
+  if (statsOut != nullptr) *statsOut = stats;
+  return audio;
+}
+
+}  // namespace crumple::sound
