@@ -18,9 +18,9 @@ using detail::Encoder;
 using detail::findOneBlock;
 using Reader = detail::SubBlockReader;
 
-constexpr std::size_t kSetupBytes = 5 * 8;
+constexpr std::size_t kSetupBytes = 7 * 8;
 constexpr std::size_t kResonatorBytes = 10 * 8;
-constexpr std::size_t kMinEventBytes = 1 + 4 + 7 * 8 + 4;
+constexpr std::size_t kMinEventBytes = 1 + 4 + 8 * 8 + 4;
 
 bool finite(const Vec3& v) { return v.allFinite(); }
 bool finiteNonNegative(double v) { return std::isfinite(v) && v >= 0.0; }
@@ -33,6 +33,9 @@ std::string setupProblem(const SoundSetupRecord& s) {
   if (!(std::isfinite(s.freeBorderRadius) && s.freeBorderRadius > 0.0))
     return "free border radius is not positive";
   if (!finiteNonNegative(s.minSlideSpeed)) return "minimum slide speed is negative";
+  if (!finiteNonNegative(s.minFreeBorder)) return "shortest free border is negative";
+  if (!(std::isfinite(s.maxTearGap) && s.maxTearGap > 0.0))
+    return "longest tear gap is not positive";
   return {};
 }
 
@@ -48,6 +51,7 @@ std::string eventProblem(const SoundEventRecord& e) {
   if (e.kind > 2) return "kind " + std::to_string(e.kind) + " is not 0, 1 or 2";
   if (e.tear < -1) return "tear " + std::to_string(e.tear) + " is below -1";
   if (!finiteNonNegative(e.amplitude)) return "amplitude is negative or not finite";
+  if (!finiteNonNegative(e.duration)) return "duration is negative or not finite";
   if (!finite(e.position) || !finite(e.normal)) return "a non-finite position or normal";
   return {};
 }
@@ -73,6 +77,8 @@ ExtensionBlock encodeSoundSetup(const SoundSetupRecord& s) {
   w.f64(s.maxDihedral);
   w.f64(s.freeBorderRadius);
   w.f64(s.minSlideSpeed);
+  w.f64(s.minFreeBorder);
+  w.f64(s.maxTearGap);
   return {kSoundSetupTag, std::move(bytes)};
 }
 
@@ -87,6 +93,7 @@ ExtensionBlock encodeSoundEvents(const std::vector<SoundEventRecord>& events) {
     w.u8(e.kind);
     w.i32(e.tear);
     w.f64(e.amplitude);
+    w.f64(e.duration);
     vec3(w, e.position);
     vec3(w, e.normal);
     w.count(e.resonators.size(), "resonators");
@@ -117,6 +124,8 @@ std::optional<SoundSetupRecord> decodeSoundSetup(const std::vector<ExtensionBloc
   s.maxDihedral = r.f64("a_max");
   s.freeBorderRadius = r.f64("free border radius");
   s.minSlideSpeed = r.f64("minimum slide speed");
+  s.minFreeBorder = r.f64("shortest free border");
+  s.maxTearGap = r.f64("longest tear gap");
   if (const auto problem = setupProblem(s); !problem.empty()) r.fail(problem);
   r.expectEnd();
   return s;
@@ -134,6 +143,7 @@ std::optional<std::vector<SoundEventRecord>> decodeSoundEvents(
     e.kind = r.u8("kind");
     e.tear = r.i32("tear");
     e.amplitude = r.f64("amplitude");
+    e.duration = r.f64("duration");
     e.position = vec3(r, "position");
     e.normal = vec3(r, "normal");
     if (const auto problem = eventProblem(e); !problem.empty()) r.fail(problem);

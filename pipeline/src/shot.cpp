@@ -499,7 +499,8 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   if (soundEvents) {
     const sound::EventParams& p = soundEvents->params();
     header.extensions.push_back(cache::encodeSoundSetup(
-        {p.gridSpacing, p.curvatureThreshold, p.maxDihedral, p.freeBorderRadius, p.minSlideSpeed}));
+        {p.gridSpacing, p.curvatureThreshold, p.maxDihedral, p.freeBorderRadius, p.minSlideSpeed,
+         p.minFreeBorder, p.maxTearGap}));
   }
   cache::CacheWriter writer(report.cachePath, header);
 
@@ -611,12 +612,14 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
       sound::SheetFrame input;
       input.mesh = &surface;
       input.rulings = record.rulings;
+      input.developableRegions = hybrid != nullptr;
       for (int v : record.handleVertices)
         if (v >= 0) input.heldVertices.push_back(v);
       for (const auto& c : touching) input.contacts.push_back({c.vertex, c.slideSpeed});
       for (const auto& a : report.tearAdvances)
         if (a.frame == frame)
           input.tearAdvances.push_back({a.event.tear, a.event.from, a.event.to});
+      input.time = t;
       input.frameDuration = 1.0 / scene.fps;
       std::vector<sound::SoundEvent> events;
       try {
@@ -938,6 +941,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     report.tearSegments = tearing->segments();
     report.tearStartKinds = tearing->startKinds();
   }
+  if (soundEvents) report.soundResonatorMs = soundEvents->resonatorMs();
   if (render && soundEvents) {
     // `run`: the soundtrack too, before the movie that muxes it in.
     SoundOptions soundOptions;
@@ -1144,6 +1148,9 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
     j.key("crumpling_events").value(static_cast<long long>(r.soundEvents[0]));
     j.key("friction_events").value(static_cast<long long>(r.soundEvents[1]));
     j.key("tearing_events").value(static_cast<long long>(r.soundEvents[2]));
+    const auto events = r.stages.find("sound events");
+    j.key("ms_per_frame").value(events != r.stages.end() ? events->second.msPerFrame() : 0.0);
+    j.key("resonator_ms_per_frame").value(r.soundResonatorMs / std::max(1, r.framesSimulated));
     j.key("wav").value(r.soundPath);  // empty: `simulate` (crumple sound makes it)
     j.endObject();
   }

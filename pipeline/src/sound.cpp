@@ -66,6 +66,7 @@ sound::SoundEvent soundEventOf(const cache::SoundEventRecord& r) {
   e.kind = static_cast<sound::EventKind>(r.kind);
   e.tear = r.tear;
   e.amplitude = r.amplitude;
+  e.duration = r.duration;
   e.position = r.position;
   e.normal = r.normal;
   for (const auto& q : r.resonators) e.resonators.push_back(resonatorOf(q));
@@ -77,6 +78,7 @@ cache::SoundEventRecord soundEventRecord(const sound::SoundEvent& e) {
   r.kind = static_cast<std::uint8_t>(e.kind);
   r.tear = e.tear;
   r.amplitude = e.amplitude;
+  r.duration = e.duration;
   r.position = e.position;
   r.normal = e.normal;
   for (const auto& q : e.resonators) r.resonators.push_back(resonatorRecord(q));

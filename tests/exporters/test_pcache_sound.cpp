@@ -30,6 +30,7 @@ std::vector<SoundEventRecord> someEvents() {
   tearing.kind = 2;
   tearing.tear = 7;
   tearing.amplitude = std::numeric_limits<double>::denorm_min();
+  tearing.duration = 0.125;
   return {crumpling, friction, tearing};
 }
 
@@ -37,16 +38,16 @@ TEST(PcacheSound, EventsAndSetupRoundTripBitForBit) {
   const auto events = someEvents();
   const ExtensionBlock block = encodeSoundEvents(events);
   EXPECT_EQ(block.tag, kSoundEventsTag);
-  // count, then per event 1 + 4 + 7 * 8 bytes + a count and 80 bytes per resonator.
-  EXPECT_EQ(block.data.size(), 4u + 3u * (1 + 4 + 56 + 4) + 3u * 80u);
+  // count, then per event 1 + 4 + 8 * 8 bytes + a count and 80 bytes per resonator.
+  EXPECT_EQ(block.data.size(), 4u + 3u * (1 + 4 + 64 + 4) + 3u * 80u);
   const auto back = decodeSoundEvents({block});
   ASSERT_TRUE(back);
   EXPECT_EQ(*back, events);
   EXPECT_FALSE(decodeSoundEvents({}));
 
-  const SoundSetupRecord setup{0.01, 5.0, 0.5, 1.0, 0.01};
+  const SoundSetupRecord setup{0.01, 5.0, 0.5, 1.0, 0.01, 0.0125, 0.5};
   const ExtensionBlock s = encodeSoundSetup(setup);
-  EXPECT_EQ(s.data.size(), 40u);
+  EXPECT_EQ(s.data.size(), 56u);
   EXPECT_EQ(decodeSoundSetup({s}), setup);
   EXPECT_FALSE(decodeSoundSetup({}));
 }
@@ -78,8 +79,8 @@ TEST(PcacheSound, MalformedBlocksThrowNamingTheRecord) {
   const auto bits = std::bit_cast<std::uint64_t>(-1.0);
   for (int k = 0; k < 8; ++k) negative.data[9 + k] = static_cast<std::uint8_t>(bits >> (8 * k));
   EXPECT_THROW(decodeSoundEvents({negative}), CorruptDataError);
-  ExtensionBlock setup = encodeSoundSetup({0.01, 5.0, 0.5, 1.0, 0.01});
-  setup.data.resize(39);
+  ExtensionBlock setup = encodeSoundSetup({0.01, 5.0, 0.5, 1.0, 0.01, 0.0125, 0.5});
+  setup.data.resize(55);
   EXPECT_THROW(decodeSoundSetup({setup}), CorruptDataError);
 }
 
@@ -96,7 +97,10 @@ TEST(PcacheSound, EncodersRejectWhatTheDecoderWould) {
   events = someEvents();
   events[2].tear = -2;
   EXPECT_THROW(encodeSoundEvents(events), std::invalid_argument);
-  EXPECT_THROW(encodeSoundSetup({0.0, 5.0, 0.5, 1.0, 0.01}), std::invalid_argument);
+  events = someEvents();
+  events[2].duration = -0.5;
+  EXPECT_THROW(encodeSoundEvents(events), std::invalid_argument);
+  EXPECT_THROW(encodeSoundSetup({0.0, 5.0, 0.5, 1.0, 0.01, 0.0125, 0.5}), std::invalid_argument);
 }
 
 }  // namespace

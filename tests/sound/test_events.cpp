@@ -72,7 +72,7 @@ TEST(SoundEvents, ACurvatureFlipIsOneCrumplingEventAndStillnessIsNone) {
   // points (all but its outer ring, 1 cm apart).
   const double interior = (w - 0.01) * (h - 0.01);
   EXPECT_NEAR(events[0].amplitude, interior / r, 0.05 * interior / r);
-  // A flip smaller than the threshold (5 / m) is no event: r = 0.5 m
+  // A flip smaller than the threshold (3 / m) is no event: r = 0.5 m
   // gives |dH| = 2 / m.
   EventDetector gentle;
   (void)gentle.detect(
@@ -225,6 +225,18 @@ TEST(SoundEvents, ATearTipThatAdvancedIsATearingEventAtItsSpeed) {
   EXPECT_EQ(events[0].tear, 3);
   EXPECT_NEAR(events[0].amplitude, 0.005 * 24.0, 1e-12);
   EXPECT_LT((events[0].position - Vec3(0.05, 0.095, 0.02)).norm(), 1e-12);
+  EXPECT_NEAR(events[0].duration, 1.0 / 24.0, 1e-15);
+  // Its next advance, 6 frames later: the tear ran on between them.
+  f.time += 6.0 / 24.0;
+  f.tearAdvances = {{3, Vec2(0.05, 0.095), Vec2(0.05, 0.09)}};
+  auto next = detector.detect(f);
+  ASSERT_EQ(next.size(), 1u);
+  EXPECT_NEAR(next[0].duration, 0.25, 1e-12);
+  EXPECT_NEAR(next[0].amplitude, 0.005 / 0.25, 1e-12);
+  // After a pause longer than maxTearGap (0.5 s) it counts 0.5 s only.
+  f.time += 2.0;
+  next = detector.detect(f);
+  EXPECT_NEAR(next[0].duration, 0.5, 1e-12);
 }
 
 TEST(SoundEvents, DetectionIsDeterministicAndRefusesBadInput) {

@@ -199,6 +199,7 @@ TEST(Soundtrack, AFasterTearIsLouderAndCrackles) {
       e.kind = EventKind::Tearing;
       e.tear = 0;
       e.amplitude = speed;
+      e.duration = 1.0 / 24.0;
       e.normal = Vec3::UnitZ();
       frames[static_cast<std::size_t>(i)].events.push_back(e);
     }

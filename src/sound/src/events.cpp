@@ -2,6 +2,7 @@
 #include "crumple/sound/events.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <deque>
 #include <map>
@@ -20,6 +21,7 @@ struct Topology {
   std::vector<double> areas;
   std::vector<double> dihedral;    // per edge (0 on the border)
   std::vector<char> curvedBorder;  // per edge: a border bent enough to vibrate
+  std::vector<char> flatRegion;    // per triangle: a planar region of the crumpling model
 };
 
 // A region reached by less than this share of an event's area makes no resonator.
@@ -49,6 +51,7 @@ Topology buildTopology(const SheetFrame& frame, const EventParams& params) {
   const auto& x = positionsOf(frame);
   t.normals.resize(nt);
   t.areas.resize(nt);
+  t.flatRegion.assign(nt, 0);
   for (std::size_t i = 0; i < nt; ++i) {
     const auto& tv = m.triangles[i];
     const Vec3 c =
@@ -57,6 +60,11 @@ Topology buildTopology(const SheetFrame& frame, const EventParams& params) {
     const double n = c.norm();
     t.areas[i] = 0.5 * n;
     t.normals[i] = n > 0.0 ? Vec3(c / n) : Vec3::Zero();
+    if (frame.developableRegions && !m.regionOfTriangle.empty()) {
+      const auto region = static_cast<std::size_t>(m.regionOfTriangle[i]);
+      t.flatRegion[i] =
+          region < m.regionTypes.size() && m.regionTypes[region] == mesh::RegionType::Flat;
+    }
   }
   t.dihedral.assign(t.edges.size(), 0.0);
   for (std::size_t e = 0; e < t.edges.size(); ++e) {
@@ -107,7 +115,8 @@ Topology buildTopology(const SheetFrame& frame, const EventParams& params) {
     const double k0 = borderCurvature[static_cast<std::size_t>(ev[0])];
     const double k1 = borderCurvature[static_cast<std::size_t>(ev[1])];
     const double k = k0 >= 0.0 && k1 >= 0.0 ? 0.5 * (k0 + k1) : std::max(k0, k1);
-    t.curvedBorder[e] = k >= minCurvature;
+    t.curvedBorder[e] =
+        k >= minCurvature && !t.flatRegion[static_cast<std::size_t>(t.edges[e].triangles[0])];
   }
   return t;
 }
@@ -186,7 +195,7 @@ std::vector<Resonator> growResonators(const SheetFrame& frame, const Topology& t
     r.centre = g.centre / g.area;
     r.normal = g.normal.norm() > 0.0 ? Vec3(g.normal.normalized()) : Vec3::UnitY();
     r.radius = std::sqrt(g.area / std::numbers::pi);
-    r.border = g.border;
+    r.border = g.border >= params.minFreeBorder ? g.border : 0.0;
     // l_r: the mean length of the rulings inside; without rulings (a flat
     // region, the elastic model), the length that makes l_r x l_c / 2 its
     // area, as the thesis' recorded rectangles (4.3.3), at most the
@@ -338,6 +347,10 @@ EventDetector::EventDetector(const EventParams& params) : params_(params) {
     throw std::invalid_argument("sound events: a_max must be in (0, pi)");
   if (!(params.freeBorderRadius > 0.0) || !std::isfinite(params.freeBorderRadius))
     throw std::invalid_argument("sound events: the free border radius must be positive");
+  if (!(params.minFreeBorder >= 0.0) || !std::isfinite(params.minFreeBorder))
+    throw std::invalid_argument("sound events: the shortest free border must be >= 0");
+  if (!(params.maxTearGap > 0.0) || !std::isfinite(params.maxTearGap))
+    throw std::invalid_argument("sound events: the longest tear gap must be positive");
   if (!(params.minSlideSpeed >= 0.0) || !std::isfinite(params.minSlideSpeed))
     throw std::invalid_argument("sound events: the minimum slide speed must be >= 0");
 }
@@ -354,7 +367,20 @@ std::vector<Resonator> findResonators(const SheetFrame& frame,
   return growResonators(frame, buildTopology(frame, params), seedTriangles, blocked, params);
 }
 
+namespace {
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+}  // namespace
+
 std::vector<SoundEvent> EventDetector::detect(const SheetFrame& frame) {
+  const auto start = Clock::now();
+  struct AddTime {
+    double& total;
+    Clock::time_point from;
+    ~AddTime() { total += msSince(from); }
+  } addTime{detectMs_, start};
   checkFrame(frame);
   const mesh::SheetMesh& m = *frame.mesh;
   std::vector<SoundEvent> events;
@@ -455,7 +481,9 @@ std::vector<SoundEvent> EventDetector::detect(const SheetFrame& frame) {
     std::sort(seeds.begin(), seeds.end());
     seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
     ev.normal = topo().normals[static_cast<std::size_t>(seeds.front())];
+    const auto grow = Clock::now();
     ev.resonators = growResonators(frame, topo(), seeds, blocked, params_);
+    resonatorMs_ += msSince(grow);
     events.push_back(std::move(ev));
   }
   previous_ = std::move(now);
@@ -510,13 +538,15 @@ std::vector<SoundEvent> EventDetector::detect(const SheetFrame& frame) {
       std::sort(seeds.begin(), seeds.end());
       seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
       ev.normal = t.normals[static_cast<std::size_t>(seeds.front())];
+      const auto grow = Clock::now();
       ev.resonators = growResonators(frame, t, seeds, blocked, params_);
+      resonatorMs_ += msSince(grow);
       events.push_back(std::move(ev));
     }
   }
 
-  // Tearing events (thesis 4.4): each tear whose tip advanced, at the speed
-  // of the frame's advance.
+  // Tearing events (thesis 4.4): each tear whose tip advanced, at its
+  // advance's length over the time since its previous advance.
   std::map<int, std::pair<double, Vec2>> tips;  // tear -> (length, last tip)
   for (const auto& a : frame.tearAdvances) {
     auto& [length, tip] = tips[a.tear];
@@ -527,7 +557,13 @@ std::vector<SoundEvent> EventDetector::detect(const SheetFrame& frame) {
     SoundEvent ev;
     ev.kind = EventKind::Tearing;
     ev.tear = tear;
-    ev.amplitude = advance.first / frame.frameDuration;
+    const auto last = lastAdvance_.find(tear);
+    ev.duration = last == lastAdvance_.end()
+                      ? frame.frameDuration
+                      : std::clamp(frame.time - last->second, frame.frameDuration,
+                                   std::max(frame.frameDuration, params_.maxTearGap));
+    lastAdvance_[tear] = frame.time;
+    ev.amplitude = advance.first / ev.duration;
     if (const auto hit = locator.locate(advance.second)) {
       ev.position = surfacePoint(m, *hit);
       ev.normal = topo().normals[static_cast<std::size_t>(hit->triangle)];

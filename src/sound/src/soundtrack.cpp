@@ -17,6 +17,7 @@ namespace crumple::sound {
 namespace {
 
 constexpr double kMinDistance = 0.01;  // m: a source nearer the ear than this is not heard
+constexpr double kTearRamp = 0.002;    // s: a tear's crackle fades in and out over this
 
 std::vector<Vec3> earsOf(const FrameEvents& f, const SoundtrackSettings& s) {
   if (s.channels == 1) return {f.listener};
@@ -175,58 +176,57 @@ Audio renderSoundtrack(const SoundDatabase& db, const Timeline& timeline,
     }
   }
 
-  // Tearing (4.4.1): each tear's crackle at its tip's speed, which moves
-  // linearly between the middles of the frames it advanced in; spatialised
-  // frame by frame as a small disk at the tip.
+  // Tearing (4.4.1): each tear's crackle at its tip's speed over the time
+  // each advance took (SoundEvent::duration, ending at its frame), its
+  // edges ramped over kTearRamp; spatialised frame by frame as a small disk
+  // at the tip.
   std::map<int, std::vector<std::pair<std::size_t, const SoundEvent*>>> tears;
   for (std::size_t f = 0; f < frameCount; ++f)
     for (const auto& e : frames[f].events)
       if (e.kind == EventKind::Tearing) tears[e.tear].push_back({f, &e});
   const double frameTime = 1.0 / timeline.fps();
+  const auto frameSample = [&](std::size_t f) { return timeline.frameStart(static_cast<int>(f)); };
   for (const auto& [tear, advances] : tears) {
-    // The speed at the middle of each frame interval (f - 1, f].
-    std::vector<double> speedAt(frameCount + 1, 0.0);
-    for (const auto& [f, e] : advances) speedAt[f] = e->amplitude;
-    const auto speed = [&](double t) {
-      const double u = t / frameTime + 0.5;  // frame f's advance peaks at t = (f - 0.5) / fps
-      if (u < 0.0) return 0.0;
-      const std::size_t f0 = static_cast<std::size_t>(std::floor(u));
-      if (f0 >= frameCount) return 0.0;
-      const double w = u - static_cast<double>(f0);
-      return (1.0 - w) * speedAt[f0] + w * (f0 + 1 < frameCount ? speedAt[f0 + 1] : 0.0);
-    };
-    // The frames over which the crackle sounds: from half a frame before
-    // the first advance to half a frame after the last.
-    const std::size_t first = advances.front().first;
-    const std::size_t last = advances.back().first;
+    // The tip's speed at every sample the tear sounds in.
+    const std::int64_t first = std::max<std::int64_t>(
+        0, timeline.sampleAt(static_cast<double>(advances.front().first) * frameTime -
+                             advances.front().second->duration));
+    const std::int64_t last = std::min<std::int64_t>(length, frameSample(advances.back().first));
+    if (last <= first) continue;
+    std::vector<double> speed(static_cast<std::size_t>(last - first), 0.0);
+    const double ramp = kTearRamp * timeline.sampleRate();
+    for (const auto& [f, e] : advances) {
+      const std::int64_t to = std::min(last, frameSample(f));
+      const std::int64_t from =
+          std::max(first, timeline.sampleAt(static_cast<double>(f) * frameTime - e->duration));
+      for (std::int64_t i = from; i < to; ++i) {
+        const double edge =
+            std::min(static_cast<double>(i - from + 1), static_cast<double>(to - i));
+        speed[static_cast<std::size_t>(i - first)] += e->amplitude * std::min(1.0, edge / ramp);
+      }
+    }
     for (std::size_t c = 0; c < static_cast<std::size_t>(s.channels); ++c) {
       TearingNoise noise(s.seed, tear, s.tearing);
       std::vector<float> track;  // the crackle at the tip, by output sample
-      for (std::size_t f = first > 0 ? first - 1 : 0; f <= std::min(last + 1, frameCount - 1);
-           ++f) {
-        // Samples [start, end) around frame f's advance: (f - 1, f].
-        const std::int64_t start = std::max<std::int64_t>(
-            0, timeline.sampleAt((static_cast<double>(f) - 1.0) * frameTime));
-        const std::int64_t end =
-            std::min<std::int64_t>(length, timeline.sampleAt(static_cast<double>(f) * frameTime));
+      noise.add(first, speed, track);
+      stats.tearingSamples += static_cast<long>(speed.size());
+      // Frame by frame: heard from where the tip was at the frame's end
+      // (the next advance's place).
+      std::size_t next = 0;
+      for (std::size_t f = 0; f < frameCount; ++f) {
+        const std::int64_t start = std::max(first, f == 0 ? 0 : frameSample(f - 1));
+        const std::int64_t end = std::min(last, frameSample(f));
         if (end <= start) continue;
-        std::vector<double> speeds(static_cast<std::size_t>(end - start));
-        for (std::int64_t i = start; i < end; ++i)
-          speeds[static_cast<std::size_t>(i - start)] = speed(timeline.timeOf(i));
-        noise.add(start, speeds, track);
-        const std::span<const float> chunk(track.data() + start, speeds.size());
-        stats.tearingSamples += static_cast<long>(speeds.size());
-        // Where the tip was: this frame's event, else the nearest one.
-        const SoundEvent* at = advances.front().second;
-        for (const auto& [g, e] : advances)
-          if (g <= f + 1) at = e;
+        while (next + 1 < advances.size() && advances[next].first < f) ++next;
+        const SoundEvent& at = *advances[next].second;
         const std::vector<Vec3> ears = earsOf(frames[f], s);
-        const auto response = responseAt(at->position, at->normal, s.tearingRadius, ears[c], s);
+        const auto response = responseAt(at.position, at.normal, s.tearingRadius, ears[c], s);
         if (!response) {
           ++stats.silentSources;
           continue;
         }
-        addClip(chunk, *response, timeline.sampleRate(), start, audio.channels[c]);
+        addClip(std::span<const float>(track.data() + start, static_cast<std::size_t>(end - start)),
+                *response, timeline.sampleRate(), start, audio.channels[c]);
       }
     }
   }

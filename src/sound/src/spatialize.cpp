@@ -1,6 +1,8 @@
 #include "crumple/sound/spatialize.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <complex>
 #include <numbers>
 #include <stdexcept>
 
@@ -45,14 +47,21 @@ std::vector<float> powerFactor(const DipoleResponse& response, int fftSize, int 
     throw std::invalid_argument("powerFactor: bad FFT size or rate");
   std::vector<float> out(static_cast<std::size_t>(fftSize / 2 + 1));
   const double g = response.direct.gain;
+  if (!response.image) {
+    std::fill(out.begin(), out.end(), static_cast<float>(g * g));
+    return out;
+  }
+  // g^2 + g~^2 + 2 g g~ cos(k x), x the phase step per bin: cos(k x) as the
+  // real part of a unit phasor turned by e^{i x} bin by bin (no cosine per
+  // bin; after M / 2 turns its error is ~1e-13).
+  const double gi = response.image->gain;
+  const double x = 2.0 * std::numbers::pi * sampleRate / fftSize *
+                   (response.image->delay - response.direct.delay);
+  const std::complex<double> turn(std::cos(x), std::sin(x));
+  std::complex<double> phasor(1.0, 0.0);
   for (std::size_t k = 0; k < out.size(); ++k) {
-    double p = g * g;
-    if (response.image) {
-      const double w = 2.0 * std::numbers::pi * static_cast<double>(k) * sampleRate / fftSize;
-      const double gi = response.image->gain;
-      p += gi * gi + 2.0 * g * gi * std::cos(w * (response.image->delay - response.direct.delay));
-    }
-    out[k] = static_cast<float>(p);
+    out[k] = static_cast<float>(g * g + gi * gi + 2.0 * g * gi * phasor.real());
+    phasor *= turn;
   }
   return out;
 }

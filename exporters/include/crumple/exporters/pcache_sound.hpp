@@ -27,6 +27,8 @@ struct SoundSetupRecord {
   double maxDihedral = 0.0;         // a_max (rad)
   double freeBorderRadius = 0.0;    // m
   double minSlideSpeed = 0.0;       // m/s
+  double minFreeBorder = 0.0;       // m
+  double maxTearGap = 0.0;          // s
   bool operator==(const SoundSetupRecord&) const = default;
 };
 
@@ -44,6 +46,7 @@ struct SoundEventRecord {
   std::uint8_t kind = 0;  // sound::EventKind: 0 crumpling, 1 friction, 2 tearing
   int tear = -1;          // tearing: the tear; else -1
   double amplitude = 0.0;
+  double duration = 0.0;  // tearing: the advance's time (s), ending at the frame
   Vec3 position = Vec3::Zero();
   Vec3 normal = Vec3::UnitY();
   std::vector<ResonatorRecord> resonators;
@@ -52,7 +55,7 @@ struct SoundEventRecord {
 
 // Throw std::invalid_argument for a value the decoder would reject: a kind
 // above 2, a non-finite value, a negative amplitude, size or radius, or a
-// tear below -1; std::length_error for more than 2^32 - 1 records.
+// tear below -1, a negative duration; std::length_error for more than 2^32 - 1 records.
 ExtensionBlock encodeSoundSetup(const SoundSetupRecord& setup);                 // tag "SNDS"
 ExtensionBlock encodeSoundEvents(const std::vector<SoundEventRecord>& events);  // tag "SEVT"
 

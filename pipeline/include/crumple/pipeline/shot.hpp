@@ -110,6 +110,7 @@ struct ShotReport {
   // (crumpling, friction, tearing), and the soundtrack `run` wrote.
   bool soundOn = false;
   std::array<long, 3> soundEvents{};
+  double soundResonatorMs = 0.0;  // of the "sound events" stage: growing the resonators
   std::string soundPath;
   std::size_t vertices = 0;
   std::size_t triangles = 0;

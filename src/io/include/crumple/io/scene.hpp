@@ -182,7 +182,7 @@ struct TearSpec {
 struct SoundSpec {
   bool enabled = false;
   double gridSpacing = 0.01;        // m (grid_mm): the curvature grid's step (Fig. 4.10)
-  double curvatureThreshold = 5.0;  // 1/m: |H_t - H_{t-1}| of a crumpling event's grid points
+  double curvatureThreshold = 3.0;  // 1/m: |H_t - H_{t-1}| of a crumpling event's grid points
   double maxDihedral = 0.5;         // a_max (rad): a ridge stops vibrations (4.3.2)
   double freeBorderRadius = 1.0;    // m (free_border_radius_cm): bent more, a border is free
   double minSlideSpeed = 0.01;      // m/s (min_slide_mm_s): slower contacts are silent

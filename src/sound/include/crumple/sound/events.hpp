@@ -14,6 +14,7 @@
 // (its free curved border length; 0: constrained) (Fig. 4.12).
 #include <array>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <vector>
 
@@ -28,13 +29,18 @@ struct EventParams {
   int maxGridPoints = 40000;
   // The curvature change |H_t - H_{t-1}| (1/m) a grid point must exceed
   // (thesis 4.3.2's threshold against small instabilities).
-  double curvatureThreshold = 5.0;
+  double curvatureThreshold = 3.0;
   double maxDihedral = 0.5;  // a_max (rad): a ridge stops vibrations (thesis 4.3.2)
   // A sheet border bent along its length to a radius below this (m), and
   // neither held nor touching, is a free curved border (Fig. 4.8): a
   // curved region's borders across its rulings, not its straight ends.
   double freeBorderRadius = 1.0;
+  // A resonator whose free borders add up to less than this (m) has none
+  // that can carry a flap: it is constrained (l_c = 0). Half the database
+  // grid's first step (2.5 cm).
+  double minFreeBorder = 0.0125;
   double minSlideSpeed = 0.01;  // m/s: slower contacts make no friction event
+  double maxTearGap = 0.5;      // s: a tear idle longer than this had stopped
 };
 
 // A resonator (thesis 4.3.2-4.3.4): its size parameters, and the disk that
@@ -56,8 +62,13 @@ struct SoundEvent {
   EventKind kind = EventKind::Crumpling;
   // Crumpling: the sum of the curvature changes, each times its grid cell's
   // area (m; grid-independent). Friction: the mean sliding speed (m/s).
-  // Tearing: the tip's speed (m/s).
+  // Tearing: the tip's speed (m/s) over `duration`.
   double amplitude = 0.0;
+  // Tearing: the time (s) the advance took, ending at the frame: since the
+  // tear's previous advance (the simulation moves a tip in jumps while the
+  // tear runs on between them), at most maxTearGap; one frame for a new
+  // tear.
+  double duration = 0.0;
   Vec3 position = Vec3::Zero();       // where it happened
   Vec3 normal = Vec3::UnitY();        // the sheet's normal there (tearing)
   int tear = -1;                      // tearing: the tear
@@ -69,6 +80,10 @@ struct SheetFrame {
   const mesh::SheetMesh* mesh = nullptr;  // positions, pattern, triangles, regions
   // The crumpling model's rulings (vertex pairs of the mesh); empty otherwise.
   std::vector<std::array<int, 2>> rulings;
+  // The crumpling model's regions: its flat regions are planar, so their
+  // borders are never free (thesis 4.3.2: flat regions are constrained).
+  // Otherwise (the elastic model) every border is judged by its bend.
+  bool developableRegions = false;
   std::vector<int> heldVertices;  // handles holding the sheet
   struct Touch {
     int vertex = -1;
@@ -81,7 +96,8 @@ struct SheetFrame {
     Vec2 to = Vec2::Zero();
   };
   std::vector<TipAdvance> tearAdvances;  // made since the previous frame
-  double frameDuration = 0.0;            // s since the previous frame (tip speeds)
+  double time = 0.0;                     // s: the frame's (tip speeds between advances)
+  double frameDuration = 0.0;            // s since the previous frame
 };
 
 // The frame-to-frame detector: keeps the curvature grid's previous values.
@@ -105,6 +121,9 @@ class EventDetector {
   // row from the pattern's lower left; nullopt where it is undefined (off
   // the sheet, across a tear, at its border).
   const std::vector<std::optional<double>>& curvature() const { return previous_; }
+  // Wall time spent so far (ms): all of detect(), and of it the resonators.
+  double detectMs() const { return detectMs_; }
+  double resonatorMs() const { return resonatorMs_; }
 
  private:
   EventParams params_;
@@ -112,6 +131,8 @@ class EventDetector {
   Vec2 origin_ = Vec2::Zero();
   int nx_ = 0, ny_ = 0;
   std::vector<std::optional<double>> previous_;
+  std::map<int, double> lastAdvance_;  // tear -> the time of its last advance
+  double detectMs_ = 0.0, resonatorMs_ = 0.0;
 };
 
 // Thesis 4.3.2 "Resonator estimation" on its own: the resonators that
