@@ -1,5 +1,5 @@
 #pragma once
-// What the whole-shot benchmarks (bench_contacts, bench_tear) share: their
+// What the whole-shot benchmarks (bench_contacts, bench_tear, bench_sound) share: their
 // command line `[SAMPLE ...] [--runs 3] [--json FILE]` and the median.
 #include <algorithm>
 #include <cstdio>

@@ -1062,6 +1062,36 @@ TEST(Scene, BadOutlinesAndTearKeysSayWhatIsWrong) {
   EXPECT_TRUE(on.tear.enabled);
   EXPECT_DOUBLE_EQ(on.tear.resistance, 0.01);
   EXPECT_DOUBLE_EQ(on.tear.texel, 5e-4);
+  EXPECT_DOUBLE_EQ(parse(kSheet + "[tear]\neps_a = 0.2\n").tear.epsA, 0.2);
+  expectError(kSheet + "[tear]\neps_a = 4\n", 5, "tear.eps_a", {"[0, pi)"});
+}
+
+TEST(Scene, TheSoundTableTurnsTheSoundtrackOnAndChecksItsKeys) {
+  EXPECT_FALSE(parse(kSheet).sound.enabled) << "no [sound]: no events";
+  const SceneSpec on = parse("[scene]\nunits = \"cm\"\n" + kSheet +
+                             "[sound]\ngrid_mm = 5\ncurvature_threshold = 4\na_max = 0.4\n"
+                             "free_border_radius_cm = 50\nmin_slide_mm_s = 2\n"
+                             "listener = [0, 100, 200]\ndatabase = \"db\"\nchannels = 1\n"
+                             "sample_rate = 44100\nformat = \"float\"\n");
+  EXPECT_TRUE(on.sound.enabled);
+  EXPECT_DOUBLE_EQ(on.sound.gridSpacing, 0.005);
+  EXPECT_DOUBLE_EQ(on.sound.curvatureThreshold, 4.0);
+  EXPECT_DOUBLE_EQ(on.sound.maxDihedral, 0.4);
+  EXPECT_DOUBLE_EQ(on.sound.freeBorderRadius, 0.5);
+  EXPECT_DOUBLE_EQ(on.sound.minSlideSpeed, 0.002);
+  ASSERT_TRUE(on.sound.listener);
+  EXPECT_TRUE(on.sound.listener->isApprox(Vec3(0.0, 1.0, 2.0)));  // scene units: cm
+  EXPECT_NE(on.sound.database.find("db"), std::string::npos);
+  EXPECT_EQ(on.sound.channels, 1);
+  EXPECT_EQ(on.sound.sampleRate, 44100);
+  EXPECT_TRUE(on.sound.floatSamples);
+  EXPECT_FALSE(parse(kSheet + "[sound]\nenabled = false\n").sound.enabled);
+  expectError(kSheet + "[sound]\nchannels = 3\n", 5, "sound.channels", {"1 (mono) or 2"});
+  expectError(kSheet + "[sound]\nsample_rate = 22050\n", 5, "sound.sample_rate", {"48000"});
+  expectError(kSheet + "[sound]\nformat = \"mp3\"\n", 5, "sound.format", {"pcm24"});
+  expectError(kSheet + "[sound]\na_max = 0\n", 5, "sound.a_max", {"(0, pi)"});
+  expectError(kSheet + "[sound]\ngrid_mm = 0.01\n", 5, "sound.grid_mm", {"0.1 mm"});
+  expectError(kSheet + "[sound]\nvolume = 1\n", 5, "sound.volume", {"unknown key"});
 }
 
 }  // namespace

@@ -124,9 +124,12 @@ Topology buildTopology(const SheetFrame& frame, const EventParams& params) {
 // Thesis 4.3.2: the regions an event sets vibrating, grown from its
 // triangles across edges below a_max without a held or touching end; one
 // resonator per region reached (Fig. 4.11), sized as Fig. 4.12.
+// `blocked`: vertices the growth does not pass; `fixed`: vertices whose
+// border edges are not free (held or touching).
 std::vector<Resonator> growResonators(const SheetFrame& frame, const Topology& t,
                                       const std::vector<int>& seeds,
-                                      const std::vector<char>& blocked, const EventParams& params) {
+                                      const std::vector<char>& blocked,
+                                      const std::vector<char>& fixed, const EventParams& params) {
   const mesh::SheetMesh& m = *frame.mesh;
   const std::size_t nt = m.triangles.size();
   std::vector<char> reached(nt, 0);
@@ -152,7 +155,38 @@ std::vector<Resonator> growResonators(const SheetFrame& frame, const Topology& t
       queue.push_back(next);
     }
   }
-  // Group by region (the elastic model's sheet is one region).
+  // One resonator per region reached (Fig. 4.11). A region, as the thesis
+  // has it: a curved region; or a flat region, the connected near-coplanar
+  // triangles the crumpling model's many small flat pieces make together
+  // (4.3.2: "the angle between two adjacent triangles is smaller than
+  // eps_a"); the elastic model's sheet is one region. Two triangles reached
+  // join across their edge below a_max (a held or touching end does not
+  // part what the event itself set vibrating) within one region id, or
+  // between two flat-typed ones.
+  std::vector<int> parent(nt);
+  for (std::size_t i = 0; i < nt; ++i) parent[i] = static_cast<int>(i);
+  const auto root = [&](int i) {
+    while (parent[static_cast<std::size_t>(i)] != i)
+      i = parent[static_cast<std::size_t>(i)] =
+          parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+    return i;
+  };
+  const auto regionOf = [&](int tri) {
+    return m.regionOfTriangle.empty() ? 0 : m.regionOfTriangle[static_cast<std::size_t>(tri)];
+  };
+  for (std::size_t e = 0; e < t.edges.size(); ++e) {
+    const auto& edge = t.edges[e];
+    if (!edge.interior()) continue;
+    const int a = edge.triangles[0], b = edge.triangles[1];
+    if (!reached[static_cast<std::size_t>(a)] || !reached[static_cast<std::size_t>(b)] ||
+        t.dihedral[e] > params.maxDihedral)
+      continue;
+    const bool bothFlat =
+        t.flatRegion[static_cast<std::size_t>(a)] && t.flatRegion[static_cast<std::size_t>(b)];
+    if (regionOf(a) != regionOf(b) && !bothFlat) continue;
+    const int ra = root(a), rb = root(b);
+    if (ra != rb) parent[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+  }
   struct Group {
     double area = 0.0, border = 0.0;
     Vec3 centre = Vec3::Zero(), normal = Vec3::Zero();
@@ -163,7 +197,7 @@ std::vector<Resonator> growResonators(const SheetFrame& frame, const Topology& t
   const auto& x = positionsOf(frame);
   for (std::size_t i = 0; i < nt; ++i) {
     if (!reached[i]) continue;
-    Group& g = groups[m.regionOfTriangle.empty() ? 0 : m.regionOfTriangle[i]];
+    Group& g = groups[root(static_cast<int>(i))];
     const auto& tv = m.triangles[i];
     const double a = t.areas[i];
     g.area += a;
@@ -177,8 +211,8 @@ std::vector<Resonator> growResonators(const SheetFrame& frame, const Topology& t
     for (int e : t.edgesOfTriangle[i]) {
       if (e < 0) continue;
       const auto& edge = t.edges[static_cast<std::size_t>(e)];
-      if (edge.interior() || !t.curvedBorder[static_cast<std::size_t>(e)] || isBlocked(edge.v[0]) ||
-          isBlocked(edge.v[1]))
+      if (edge.interior() || !t.curvedBorder[static_cast<std::size_t>(e)] ||
+          fixed[static_cast<std::size_t>(edge.v[0])] || fixed[static_cast<std::size_t>(edge.v[1])])
         continue;
       g.border +=
           (x[static_cast<std::size_t>(edge.v[0])] - x[static_cast<std::size_t>(edge.v[1])]).norm();
@@ -364,7 +398,8 @@ std::vector<Resonator> findResonators(const SheetFrame& frame,
   for (int s : seedTriangles)
     if (s < 0 || static_cast<std::size_t>(s) >= frame.mesh->triangles.size())
       throw std::invalid_argument("findResonators: a seed triangle out of range");
-  return growResonators(frame, buildTopology(frame, params), seedTriangles, blocked, params);
+  return growResonators(frame, buildTopology(frame, params), seedTriangles, blocked, blocked,
+                        params);
 }
 
 namespace {
@@ -482,7 +517,7 @@ std::vector<SoundEvent> EventDetector::detect(const SheetFrame& frame) {
     seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
     ev.normal = topo().normals[static_cast<std::size_t>(seeds.front())];
     const auto grow = Clock::now();
-    ev.resonators = growResonators(frame, topo(), seeds, blocked, params_);
+    ev.resonators = growResonators(frame, topo(), seeds, blocked, blocked, params_);
     resonatorMs_ += msSince(grow);
     events.push_back(std::move(ev));
   }
@@ -508,6 +543,8 @@ std::vector<SoundEvent> EventDetector::detect(const SheetFrame& frame) {
       for (int v : m.triangles[i])
         if (speed[static_cast<std::size_t>(v)] >= 0.0)
           trianglesAt[static_cast<std::size_t>(v)].push_back(static_cast<int>(i));
+    std::vector<char> held(m.vertexCount(), 0);
+    for (int v : frame.heldVertices) held[static_cast<std::size_t>(v)] = 1;
     std::vector<char> done(m.vertexCount(), 0);
     for (std::size_t v0 = 0; v0 < m.vertexCount(); ++v0) {
       if (speed[v0] < 0.0 || done[v0]) continue;
@@ -539,7 +576,11 @@ std::vector<SoundEvent> EventDetector::detect(const SheetFrame& frame) {
       seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
       ev.normal = t.normals[static_cast<std::size_t>(seeds.front())];
       const auto grow = Clock::now();
-      ev.resonators = growResonators(frame, t, seeds, blocked, params_);
+      // The vibration starts where the sheet rubs and spreads from there:
+      // the held points and the ridges stop it, the contacts do not (the
+      // rubbing ones are its source, and a coarse mesh touches a table at
+      // scattered vertices that would otherwise wall every patch in).
+      ev.resonators = growResonators(frame, t, seeds, held, blocked, params_);
       resonatorMs_ += msSince(grow);
       events.push_back(std::move(ev));
     }

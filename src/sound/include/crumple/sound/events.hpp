@@ -138,7 +138,9 @@ class EventDetector {
 // Thesis 4.3.2 "Resonator estimation" on its own: the resonators that
 // `seedTriangles` set vibrating. `blocked[v]` marks held and touching
 // vertices; an edge with such an end, a dihedral angle above a_max or on the
-// sheet's border stops the growth.
+// sheet's border stops the growth, and a border edge with such an end is
+// not free. (A friction event's own growth passes touching vertices:
+// EventDetector::detect.)
 std::vector<Resonator> findResonators(const SheetFrame& frame,
                                       const std::vector<int>& seedTriangles,
                                       const std::vector<char>& blocked, const EventParams& params);

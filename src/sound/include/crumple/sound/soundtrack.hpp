@@ -32,7 +32,7 @@ struct SoundtrackSettings {
   // Levels. A source's gain is its dipole's (a^3 cos(theta) / R) over that
   // of a 5 cm disk facing the listener 1 m away (so 1 there), times:
   double referenceRadius = 0.05;     // m
-  double crumplingReference = 1e-3;  // m: the event amplitude that plays a clip as stored
+  double crumplingReference = 0.01;  // m: the event amplitude that plays a clip as stored
   double frictionReference = 0.1;    // m/s: the slide speed that plays a spectrum as stored
   double crumplingGain = 1.0;
   double frictionGain = 1.0;
