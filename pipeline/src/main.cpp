@@ -216,14 +216,20 @@ int inspectCommand(const Args& a) {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "crumple: paper animation -- simulate a sheet from keyframed handles, cache it, render it.\n"
+      "crumple: paper animation -- simulate a sheet from keyframed handles, cache it, render it, "
+      "make its sound.\n"
       "Exit status: 0 success, 1 internal failure, 2 bad input."};
   app.set_version_flag("--version", "crumple 0.1.0");
   app.require_subcommand(1);
   Args a;
 
-  auto* run = app.add_subcommand("run", "Simulate a shot, write its cache and render its frames.");
-  auto* simulate = app.add_subcommand("simulate", "Simulate a shot and write its cache only.");
+  auto* run = app.add_subcommand(
+      "run",
+      "Simulate a shot, write its cache and render its frames (and, for a scene with [sound], "
+      "write its soundtrack sound.wav).");
+  auto* simulate = app.add_subcommand(
+      "simulate",
+      "Simulate a shot and write its cache only (with the sound events of a scene with [sound]).");
   for (auto* cmd : {run, simulate}) {
     cmd->add_option("SCENE", a.scene, "scene.toml, or a folder holding one")->required();
     cmd->add_option("--out", a.out,

@@ -14,7 +14,7 @@ using namespace crumple::testing;
 TEST(Cli, HelpForEverySubcommand) {
   const auto top = runCrumple("--help");
   EXPECT_EQ(top.status, 0);
-  for (const char* sub : {"run", "simulate", "render", "inspect", "compare"}) {
+  for (const char* sub : {"run", "simulate", "render", "sound", "inspect", "compare"}) {
     EXPECT_NE(top.output.find(sub), std::string::npos) << sub;
     const auto r = runCrumple(std::string(sub) + " --help");
     EXPECT_EQ(r.status, 0) << sub;
@@ -23,6 +23,7 @@ TEST(Cli, HelpForEverySubcommand) {
   EXPECT_EQ(runCrumple("").status, 2) << "a subcommand is required";
   EXPECT_EQ(runCrumple("frobnicate").status, 2);
   EXPECT_EQ(runCrumple("run").status, 2) << "SCENE is required";
+  EXPECT_EQ(runCrumple("sound").status, 2) << "CACHE is required";
 }
 
 TEST(Cli, RunWritesCacheFramesSummaryAndProgressLines) {
