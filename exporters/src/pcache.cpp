@@ -793,4 +793,49 @@ std::vector<CacheIssue> CacheReader::verifyAll() const {
   return issues;
 }
 
+// ===========================================================================
+// Resume
+
+CacheWriter::CacheWriter() : impl_(std::make_unique<Impl>()) {}
+
+std::unique_ptr<CacheWriter> CacheWriter::resume(const std::string& path, const CacheHeader& header,
+                                                 std::size_t keepFrames) {
+  const CacheReader reader(path);
+  if (reader.frameCount() < keepFrames)
+    throw InputError(path, "holds " + plural(reader.frameCount(), "complete frame") + ", " +
+                               std::to_string(keepFrames) + " needed to resume");
+  // The header must be the one this run writes, byte for byte.
+  Bytes expected(kFileMagic.begin(), kFileMagic.end());
+  encodeHeader(expected, header);
+  const InputFile in(path);
+  Bytes found(expected.size());
+  if (!in.readAt(0, found.data(), found.size()) || found != expected)
+    throw InputError(path, "was not written by this shot (its header differs): cannot resume it");
+  // Where the kept frames end: the next frame's chunk, else the last kept
+  // chunk's end.
+  std::uint64_t end = expected.size();
+  if (keepFrames > 0) {
+    const std::uint64_t last = reader.impl_->index[keepFrames - 1].offset;
+    Chunk c;
+    std::string problem;
+    if (readChunk(in, last, c, problem) != ChunkStatus::Ok)
+      throw InputError(path, "cannot resume: " + problem);
+    end = c.end;
+  }
+  std::unique_ptr<CacheWriter> writer(new CacheWriter());
+  Impl& w = *writer->impl_;
+  w.path = path;
+  w.index.assign(reader.impl_->index.begin(),
+                 reader.impl_->index.begin() + static_cast<std::ptrdiff_t>(keepFrames));
+  if (keepFrames > 0) encodeTopology(w.previousTopology, reader.readFrame(keepFrames - 1));
+  std::error_code ec;
+  std::filesystem::resize_file(path, end, ec);
+  if (ec) throw InputError(path, "cannot resume: " + ec.message());
+  w.file.reset(std::fopen(path.c_str(), "r+b"));
+  if (!w.file || std::fseek(w.file.get(), static_cast<long>(end), SEEK_SET) != 0)
+    throw InputError(path, "cannot resume: " + errnoText(errno));
+  w.offset = end;
+  return writer;
+}
+
 }  // namespace crumple::cache

@@ -42,6 +42,8 @@ struct Args {
   bool movie = false;
   bool json = false;
   bool debugStructure = false;
+  int checkpointEvery = 0;
+  bool resume = false;
   // compare
   std::string imageA, imageB, metric = "flip", diff;
   double tolerance = 0.05;
@@ -109,6 +111,8 @@ int runOrSimulate(const Args& a, bool render) {
   options.seed = a.seed;
   options.render = render;
   options.debugStructure = a.debugStructure;
+  options.checkpointEvery = a.checkpointEvery;
+  options.resume = a.resume;
   if (render) options.rendering = renderSettings(a);
   const auto report = pipeline::runShot(scene, options);
   std::fputs(pipeline::summaryText(report).c_str(), stdout);
@@ -243,6 +247,13 @@ int main(int argc, char** argv) {
         "elastic model draws no random numbers)");
     cmd->add_option("--threads", a.threads, "worker threads; results are identical for any count")
         ->check(CLI::Range(1, 256));
+    cmd->add_option("--checkpoint-every", a.checkpointEvery,
+                    "N: write the whole simulation state to DIR/checkpoint.bin every N frames "
+                    "(atomically); the elastic model without [tear] only, so far")
+        ->check(CLI::Range(1, 1 << 30));
+    cmd->add_flag("--resume", a.resume,
+                  "go on from DIR/checkpoint.bin after an interruption: the cache ends "
+                  "byte-identical to an uninterrupted run's");
   }
   addRenderOptions(run, a);
   run->add_flag(

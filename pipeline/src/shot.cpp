@@ -15,6 +15,7 @@
 #include <optional>
 #include <string_view>
 
+#include "checkpoint.hpp"
 #include "crumple/core/error.hpp"
 #include "crumple/core/progress.hpp"
 #include "crumple/exporters/pcache_contacts.hpp"
@@ -384,6 +385,14 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     range = *options.frames;
   }
   const bool render = options.render && scene.output.frames;
+  if (options.checkpointEvery < 0)
+    throw InputError("--checkpoint-every", "must be a number of frames >= 1");
+  if ((options.checkpointEvery > 0 || options.resume) &&
+      (scene.model.type == io::ModelSpec::Type::Hybrid || scene.tear.enabled))
+    throw InputError(options.resume ? "--resume" : "--checkpoint-every",
+                     "checkpoints are not written yet for the crumpling model or for tearing "
+                     "(scene " +
+                         scene.file + "); they are for the elastic model without [tear]");
 
   // Everything that can be wrong with the input is checked before any output
   // is written: no partial cache or frames that look valid.
@@ -502,7 +511,14 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
         {p.gridSpacing, p.curvatureThreshold, p.maxDihedral, p.freeBorderRadius, p.minSlideSpeed,
          p.minFreeBorder, p.maxTearGap}));
   }
-  cache::CacheWriter writer(report.cachePath, header);
+  // Resume (issue 8): the checkpoint says which frame the state is at and
+  // how many cached frames go with it; the cache keeps those and goes on.
+  const std::string checkpointPath = (fs::path(report.outDir) / kCheckpointFile).string();
+  std::optional<Checkpoint> resumed;
+  if (options.resume) resumed = readCheckpoint(checkpointPath, scene, seed, range.last);
+  std::unique_ptr<cache::CacheWriter> writer =
+      resumed ? cache::CacheWriter::resume(report.cachePath, header, resumed->cachedFrames)
+              : std::make_unique<cache::CacheWriter>(report.cachePath, header);
 
   cache::FrameRecord record;
   record.triangles = sheet.triangles;
@@ -639,7 +655,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
       report.stages["sound events"].frames += 1;
     }
     auto start = Clock::now();
-    writer.append(record);
+    writer->append(record);
     report.stages["cache"].totalMs += msSince(start);
     report.stages["cache"].frames += 1;
     const auto m = measureFrame(record);
@@ -871,9 +887,37 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     report.stages["tear"].frames += 1;
   };
 
+  // The whole state after frame `frame` (issue 8), written atomically.
+  const auto checkpoint = [&](int frame) {
+    const auto start = Clock::now();
+    StateWriter w;
+    writeCheckpointHead(w, scene, seed, range.last, frame, writer->framesWritten());
+    saveReport(w, report);
+    elastic->saveState(w);
+    w.boolean(soundEvents.has_value());
+    if (soundEvents) soundEvents->saveState(w);
+    writeCheckpointFile(checkpointPath, w);
+    report.stages["checkpoint"].totalMs += msSince(start);
+    report.stages["checkpoint"].frames += 1;
+  };
+  int firstFrame = scene.frameStart + 1;
+  if (resumed) {
+    StateReader& in = *resumed->state;
+    restoreReport(in, report);
+    elastic->restoreState(in);
+    if (in.boolean() != soundEvents.has_value())
+      throw InputError(checkpointPath, "was written with a different [sound] setting");
+    if (soundEvents) soundEvents->restoreState(in);
+    if (!in.atEnd()) in.fail("trailing bytes");
+    firstFrame = resumed->frame + 1;
+    if (options.log != nullptr)
+      std::fprintf(options.log, "resuming after frame %d (%s)\n", resumed->frame,
+                   checkpointPath.c_str());
+  }
+
   try {
-    emit(scene.frameStart);
-    for (int frame = scene.frameStart + 1; frame <= range.last; ++frame) {
+    if (!resumed) emit(scene.frameStart);
+    for (int frame = firstFrame; frame <= range.last; ++frame) {
       if (hybrid) {
         // The frame's substeps are the paper's animation steps (Fig. 16):
         // each an elastic step, the geometric step, cones, S_P rebuild and
@@ -925,18 +969,20 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
       carriedContacts.reset();
       if (tearing) tearFrame(frame);
       emit(frame);
+      if (options.checkpointEvery > 0 && (frame - scene.frameStart) % options.checkpointEvery == 0)
+        checkpoint(frame);
     }
   } catch (const NumericalError& e) {
     progress.finish();
     report.error = e.what();
     report.hybrid = hybridModel;
     if (report.framesSimulated > 0) report.meanCMean /= report.framesSimulated;
-    writer.close();  // the cache stays valid up to the last good frame
+    writer->close();  // the cache stays valid up to the last good frame
     writeTextAtomically(report.summaryPath, summaryJson(scene, report));
     throw;
   }
   progress.finish();
-  writer.close();
+  writer->close();
   if (tearing) {
     report.tearSegments = tearing->segments();
     report.tearStartKinds = tearing->startKinds();

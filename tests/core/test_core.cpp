@@ -1,16 +1,20 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <numeric>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "crumple/core/crc32.hpp"
+#include "crumple/core/error.hpp"
 #include "crumple/core/parallel.hpp"
 #include "crumple/core/progress.hpp"
 #include "crumple/core/rng.hpp"
+#include "crumple/core/state_io.hpp"
 #include "crumple/core/units.hpp"
 
 using namespace crumple;
@@ -103,4 +107,47 @@ TEST(Progress, WritesOneLinePerStepOrNothingWithoutAStream) {
   EXPECT_FALSE(quiet.interactive());
   quiet.update(2);  // no stream: nothing to write to, and no crash
   quiet.finish();
+}
+
+// The checkpoint's byte layer (issue 8): everything written reads back bit
+// for bit; a wrong section, a short state or a huge count is refused.
+TEST(StateIo, RoundTripsAndRefusesDamage) {
+  StateWriter w;
+  w.tag("TEST");
+  w.u8(7);
+  w.i32(-5);
+  w.i64(-1234567890123);
+  w.f64(-0.0);
+  w.f64(std::numeric_limits<double>::denorm_min());
+  w.boolean(true);
+  w.str("frame \xff");
+  w.vec3s({Vec3(1, 2, 3), Vec3(-1, 0.5, 1e300)});
+  w.f64s({0.1, 0.2});
+  w.i32s({1, -2, 3});
+  w.bytes({1, 0, 1});
+  w.triangles({{0, 1, 2}});
+  StateReader r(w.data(), "t");
+  r.tag("TEST");
+  EXPECT_EQ(r.u8(), 7);
+  EXPECT_EQ(r.i32(), -5);
+  EXPECT_EQ(r.i64(), -1234567890123);
+  EXPECT_TRUE(std::signbit(r.f64()));
+  EXPECT_EQ(r.f64(), std::numeric_limits<double>::denorm_min());
+  EXPECT_TRUE(r.boolean());
+  EXPECT_EQ(r.str(), "frame \xff");
+  const auto v = r.vec3s();
+  ASSERT_EQ(v.size(), 2u);
+  EXPECT_EQ(v[1].z(), 1e300);
+  EXPECT_EQ(r.f64s(), (std::vector<double>{0.1, 0.2}));
+  EXPECT_EQ(r.i32s(), (std::vector<int>{1, -2, 3}));
+  EXPECT_EQ(r.bytes(), (std::vector<char>{1, 0, 1}));
+  EXPECT_EQ(r.triangles().at(0)[2], 2);
+  EXPECT_TRUE(r.atEnd());
+  EXPECT_THROW(r.u8(), CorruptDataError);  // past the end
+  StateReader wrong(w.data(), "t");
+  EXPECT_THROW(wrong.tag("ELAS"), CorruptDataError);
+  StateWriter huge;
+  huge.u64(std::uint64_t{1} << 60);
+  StateReader h(huge.data(), "t");
+  EXPECT_THROW((void)h.f64s(), CorruptDataError);
 }

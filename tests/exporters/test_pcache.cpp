@@ -262,6 +262,41 @@ TEST_F(PcacheTest, WriterDestroyedWithoutCloseLeavesRecoverableFrames) {
   }
 }
 
+// Checkpoint and resume (issue 8): a cache cut anywhere after frame k (a
+// killed run: later frames, a torn chunk, or a finished file's footer) and
+// resumed from k frames, then given the same frames, is byte for byte the
+// uninterrupted cache; the topology shared across the cut is stored once.
+TEST_F(PcacheTest, AResumedWriterWritesTheUninterruptedBytes) {
+  const std::string whole = file("whole.pcache");
+  const auto sizes = writeCache(whole);
+  const auto reference = readBytes(whole);
+  for (const int keep : {0, 2, 4}) {  // 4: after the topology changed at frame 3
+    for (const bool torn : {false, true}) {
+      const std::string path = file("resumed.pcache");
+      writeCache(path, /*close=*/false);
+      if (torn)  // killed in the middle of the chunk after the kept ones
+        writeBytes(path, truncated(readBytes(path), sizes[static_cast<std::size_t>(keep) + 1] - 7));
+      const auto w = CacheWriter::resume(path, makeHeader(), static_cast<std::size_t>(keep));
+      EXPECT_EQ(w->framesWritten(), static_cast<std::size_t>(keep));
+      for (int k = keep; k < kFrames; ++k) w->append(makeFrame(k));
+      w->close();
+      EXPECT_EQ(readBytes(path), reference) << "kept " << keep << (torn ? ", torn" : "");
+    }
+  }
+  // A finished cache resumed: its footer goes too.
+  const std::string done = file("done.pcache");
+  writeCache(done);
+  const auto w = CacheWriter::resume(done, makeHeader(), kFrames - 1);
+  w->append(makeFrame(kFrames - 1));
+  w->close();
+  EXPECT_EQ(readBytes(done), reference);
+  // Another shot's header, or more frames than it holds: refused.
+  CacheHeader other = makeHeader();
+  other.seed += 1;
+  EXPECT_THROW(CacheWriter::resume(done, other, 2), InputError);
+  EXPECT_THROW(CacheWriter::resume(done, makeHeader(), kFrames + 1), InputError);
+}
+
 TEST_F(PcacheTest, DamagedFooterOrTrailerFallsBackToScanning) {
   const std::string path = file("shot.pcache");
   const auto sizes = writeCache(path);

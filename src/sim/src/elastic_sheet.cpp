@@ -1337,6 +1337,52 @@ std::vector<ElasticSheet::TriangleForce> ElasticSheet::membraneForcesOn(int vert
 long ElasticSheet::contactVertexSteps() const { return impl_->contactVertexSteps; }
 const std::vector<ContactSample>& ElasticSheet::contacts() const { return impl_->lastContacts; }
 
+void ElasticSheet::saveState(StateWriter& out) const {
+  const Impl& s = *impl_;
+  out.tag("ELAS");
+  out.vec3s(s.x);
+  out.vec3s(s.v);
+  out.f64s(s.hingeRest);
+  out.f64s(s.hingeFactor);
+  out.f64s(s.hingeBranch);
+  out.count(s.lastContacts.size());
+  for (const auto& c : s.lastContacts) {
+    out.i32(c.vertex);
+    out.i32(c.collider);
+    out.f64(c.slideSpeed);
+    out.f64(c.normalForce);
+  }
+}
+
+void ElasticSheet::restoreState(StateReader& in) {
+  Impl& s = *impl_;
+  in.tag("ELAS");
+  std::vector<Vec3> x = in.vec3s(), v = in.vec3s();
+  std::vector<double> rest = in.f64s(), factor = in.f64s(), branch = in.f64s();
+  if (x.size() != s.vertexCount || v.size() != s.vertexCount)
+    in.fail("the elastic state has " + std::to_string(x.size()) + " vertices, the sheet " +
+            std::to_string(s.vertexCount));
+  if (rest.size() != s.hinges.size() || factor.size() != s.hinges.size() ||
+      branch.size() != s.hinges.size())
+    in.fail("the elastic state's hinges do not match the sheet's " +
+            std::to_string(s.hinges.size()));
+  std::vector<ContactSample> contacts(in.count(24));
+  for (auto& c : contacts) {
+    c.vertex = in.i32();
+    c.collider = in.i32();
+    c.slideSpeed = in.f64();
+    c.normalForce = in.f64();
+    if (c.vertex < 0 || static_cast<std::size_t>(c.vertex) >= s.vertexCount)
+      in.fail("a contact's vertex is out of range");
+  }
+  s.x = std::move(x);
+  s.v = std::move(v);
+  s.hingeRest = std::move(rest);
+  s.hingeFactor = std::move(factor);
+  s.hingeBranch = std::move(branch);
+  s.lastContacts = std::move(contacts);
+}
+
 const std::vector<Vec3>& ElasticSheet::positions() const { return impl_->x; }
 const std::vector<Vec3>& ElasticSheet::velocities() const { return impl_->v; }
 

@@ -389,6 +389,47 @@ EventDetector::EventDetector(const EventParams& params) : params_(params) {
     throw std::invalid_argument("sound events: the minimum slide speed must be >= 0");
 }
 
+void EventDetector::saveState(StateWriter& out) const {
+  out.tag("SEVD");
+  out.f64(step_);
+  out.vec2(origin_);
+  out.i32(nx_);
+  out.i32(ny_);
+  out.count(previous_.size());
+  for (const auto& h : previous_) {
+    out.boolean(h.has_value());
+    out.f64(h.value_or(0.0));
+  }
+  out.count(lastAdvance_.size());
+  for (const auto& [tear, time] : lastAdvance_) {
+    out.i32(tear);
+    out.f64(time);
+  }
+}
+
+void EventDetector::restoreState(StateReader& in) {
+  in.tag("SEVD");
+  step_ = in.f64();
+  origin_ = in.vec2();
+  nx_ = in.i32();
+  ny_ = in.i32();
+  const std::size_t n = in.count(9);
+  if (nx_ < 0 || ny_ < 0 || n != static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_))
+    in.fail("the sound grid's size does not match its points");
+  previous_.assign(n, std::nullopt);
+  for (auto& h : previous_) {
+    const bool defined = in.boolean();
+    const double value = in.f64();
+    if (defined) h = value;
+  }
+  lastAdvance_.clear();
+  const std::size_t tears = in.count(12);
+  for (std::size_t k = 0; k < tears; ++k) {
+    const int tear = in.i32();
+    lastAdvance_[tear] = in.f64();
+  }
+}
+
 std::vector<Resonator> findResonators(const SheetFrame& frame,
                                       const std::vector<int>& seedTriangles,
                                       const std::vector<char>& blocked, const EventParams& params) {

@@ -107,9 +107,20 @@ class CacheWriter {
   // Writes the footer and trailer and closes the file. A second call does
   // nothing; append() after close() throws std::logic_error.
   void close();
+
+  // Resume (issue 8, checkpoint and resume): reopens the cache at `path` that
+  // an interrupted (or finished) run wrote with `header`, keeps its first
+  // `keepFrames` complete frames and cuts everything after them (frames
+  // written after the checkpoint, a torn last chunk, the footer), so that
+  // appending the following frames writes the very bytes the uninterrupted
+  // run would have. Throws InputError when the file cannot be opened or
+  // written, holds fewer complete frames, or its header is not `header`'s.
+  static std::unique_ptr<CacheWriter> resume(const std::string& path, const CacheHeader& header,
+                                             std::size_t keepFrames);
   std::size_t framesWritten() const;
 
  private:
+  CacheWriter();
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
@@ -154,6 +165,7 @@ class CacheReader {
   const std::string& path() const;
 
  private:
+  friend class CacheWriter;  // resume() reads the index
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

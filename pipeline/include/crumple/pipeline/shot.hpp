@@ -50,6 +50,12 @@ struct ShotOptions {
   RenderSettings rendering;
   std::FILE* log = stderr;  // progress and notes; nullptr: a quiet run
   int interactive = -1;     // -1: detect a terminal on `log`
+  // Checkpoint and resume (issue 8): every this many frames (0: never) the
+  // whole simulation state goes to DIR/checkpoint.bin, atomically; `resume`
+  // goes on from it, and the cache ends byte-identical to an uninterrupted
+  // run's. The elastic model without tearing only, so far.
+  int checkpointEvery = 0;
+  bool resume = false;
 };
 
 // Milliseconds spent per stage, summed over the frames it ran for.

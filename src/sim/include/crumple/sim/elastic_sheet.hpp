@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "crumple/core/state_io.hpp"
 #include "crumple/core/types.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/sim/material.hpp"
@@ -148,6 +149,13 @@ class ElasticSheet {
   // The contacts at the end of the last accepted (sub)step, sorted by
   // (vertex, collider), one per pair (forces summed, the fastest slide).
   const std::vector<ContactSample>& contacts() const;
+  // Checkpoint and resume (issue 8): what the sheet carries from one step to
+  // the next (positions, velocities, each hinge's rest angle, stiffness
+  // factor and branch, the last step's contacts), written for a sheet built
+  // again on the same mesh. restoreState throws CorruptDataError when the
+  // state does not fit this sheet's mesh.
+  void saveState(StateWriter& out) const;
+  void restoreState(StateReader& in);
 
   const std::vector<Vec3>& positions() const;
   const std::vector<Vec3>& velocities() const;

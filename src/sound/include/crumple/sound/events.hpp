@@ -18,6 +18,7 @@
 #include <optional>
 #include <vector>
 
+#include "crumple/core/state_io.hpp"
 #include "crumple/core/types.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
 
@@ -121,6 +122,11 @@ class EventDetector {
   // row from the pattern's lower left; nullopt where it is undefined (off
   // the sheet, across a tear, at its border).
   const std::vector<std::optional<double>>& curvature() const { return previous_; }
+  // Checkpoint and resume (issue 8): the grid and its last curvatures, and
+  // each tear's last advance. restoreState throws CorruptDataError for a
+  // malformed state.
+  void saveState(StateWriter& out) const;
+  void restoreState(StateReader& in);
   // Wall time spent so far (ms): all of detect(), and of it the resonators.
   double detectMs() const { return detectMs_; }
   double resonatorMs() const { return resonatorMs_; }

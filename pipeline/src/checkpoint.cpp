@@ -1,0 +1,169 @@
+#include "checkpoint.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "crumple/core/crc32.hpp"
+#include "crumple/core/error.hpp"
+
+namespace crumple::pipeline {
+namespace {
+
+constexpr std::uint32_t kCheckpointVersion = 1;
+constexpr char kMagic[9] = "CRUMPCKP";
+
+std::uint32_t sceneHash(const io::SceneSpec& scene) {
+  return crc32(scene.sourceText.data(), scene.sourceText.size());
+}
+
+}  // namespace
+
+void writeCheckpointHead(StateWriter& w, const io::SceneSpec& scene, std::uint64_t seed,
+                         int lastFrame, int frame, std::size_t cachedFrames) {
+  w.tag("CKPT");
+  w.u32(kCheckpointVersion);
+  w.u32(sceneHash(scene));
+  w.u64(scene.sourceText.size());
+  w.u64(seed);
+  w.i32(scene.frameStart);
+  w.i32(lastFrame);
+  w.i32(frame);
+  w.count(cachedFrames);
+}
+
+void writeCheckpointFile(const std::string& path, const StateWriter& w) {
+  const std::string tmp = path + ".tmp";
+  const auto& data = w.data();
+  const std::uint32_t crc = crc32(data.data(), data.size());
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (f == nullptr)
+    throw InputError(tmp, std::string("cannot write the checkpoint: ") + std::strerror(errno));
+  std::uint8_t tail[4];
+  for (int k = 0; k < 4; ++k) tail[k] = static_cast<std::uint8_t>(crc >> (8 * k));
+  const bool ok = std::fwrite(kMagic, 1, 8, f) == 8 &&
+                  std::fwrite(data.data(), 1, data.size(), f) == data.size() &&
+                  std::fwrite(tail, 1, 4, f) == 4 && std::fflush(f) == 0 && ::fsync(fileno(f)) == 0;
+  const int err = errno;
+  if (std::fclose(f) != 0 || !ok) {
+    std::remove(tmp.c_str());
+    throw InputError(tmp, std::string("cannot write the checkpoint: ") + std::strerror(err));
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) throw InputError(path, "cannot write the checkpoint: " + ec.message());
+}
+
+Checkpoint readCheckpoint(const std::string& path, const io::SceneSpec& scene, std::uint64_t seed,
+                          int lastFrame) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    throw InputError(path, "no checkpoint to resume from (run with --checkpoint-every N first)");
+  std::vector<std::uint8_t> file((std::istreambuf_iterator<char>(in)), {});
+  if (file.size() < 12 || std::memcmp(file.data(), kMagic, 8) != 0)
+    throw InputError(path, "not a crumple checkpoint");
+  std::uint32_t stored = 0;
+  for (int k = 0; k < 4; ++k)
+    stored |= static_cast<std::uint32_t>(file[file.size() - 4 + static_cast<std::size_t>(k)])
+              << (8 * k);
+  auto bytes = std::make_shared<std::vector<std::uint8_t>>(file.begin() + 8, file.end() - 4);
+  if (crc32(bytes->data(), bytes->size()) != stored)
+    throw InputError(path, "the checkpoint is damaged (CRC mismatch)");
+  Checkpoint c;
+  c.bytes = bytes;
+  c.state = std::make_unique<StateReader>(*bytes, path);
+  StateReader& r = *c.state;
+  try {
+    r.tag("CKPT");
+    if (const auto v = r.u32(); v != kCheckpointVersion)
+      throw InputError(path, std::string("checkpoint version ") + std::to_string(v) +
+                                 ", this crumple reads " + std::to_string(kCheckpointVersion));
+    const std::uint32_t hash = r.u32();
+    const std::uint64_t length = r.u64();
+    if (hash != sceneHash(scene) || length != scene.sourceText.size())
+      throw InputError(path, "belongs to another scene (" + scene.file +
+                                 " changed since it was written): cannot resume");
+    if (r.u64() != seed) throw InputError(path, "was written with another seed: cannot resume");
+    const int first = r.i32(), last = r.i32();
+    if (first != scene.frameStart || last != lastFrame)
+      throw InputError(path, std::string("covers frames ") + std::to_string(first) + "-" +
+                                 std::to_string(last) + ", this run " +
+                                 std::to_string(scene.frameStart) + "-" +
+                                 std::to_string(lastFrame) + ": cannot resume");
+    c.frame = r.i32();
+    c.cachedFrames = r.count(0);
+    if (c.frame < first || c.frame > last)
+      r.fail(std::string("frame ") + std::to_string(c.frame) + " out of range");
+  } catch (const CorruptDataError& e) {
+    throw InputError(path, e.what());
+  }
+  return c;
+}
+
+void saveReport(StateWriter& w, const ShotReport& r) {
+  w.tag("REPT");
+  w.i32(r.framesSimulated);
+  w.i64(r.newtonIterations);
+  w.i64(r.substeps);
+  w.i64(r.halvings);
+  w.i64(r.elasticRetries);
+  w.f64(r.contactMs);
+  w.f64(r.selfContactMs);
+  w.i64(r.selfContactSteps);
+  w.f64(r.maxContactDepth);
+  w.i32(r.maxContactDepthFrame);
+  w.i64(r.contactSamples);
+  for (long n : r.soundEvents) w.i64(n);
+  w.f64(r.soundResonatorMs);
+  w.f64(r.maxHandleError);
+  w.f64(r.maxStrain);
+  w.f64(r.meanCMean);
+  w.f64(r.maxCMean);
+  w.i32(r.maxCMeanFrame);
+  w.f64(r.maxNComp);
+  w.count(r.stages.size());
+  for (const auto& [name, cost] : r.stages) {
+    w.str(name);
+    w.f64(cost.totalMs);
+    w.i64(cost.frames);
+  }
+}
+
+void restoreReport(StateReader& in, ShotReport& r) {
+  in.tag("REPT");
+  r.framesSimulated = in.i32();
+  r.newtonIterations = in.i64();
+  r.substeps = in.i64();
+  r.halvings = in.i64();
+  r.elasticRetries = in.i64();
+  r.contactMs = in.f64();
+  r.selfContactMs = in.f64();
+  r.selfContactSteps = in.i64();
+  r.maxContactDepth = in.f64();
+  r.maxContactDepthFrame = in.i32();
+  r.contactSamples = in.i64();
+  for (long& n : r.soundEvents) n = in.i64();
+  r.soundResonatorMs = in.f64();
+  r.maxHandleError = in.f64();
+  r.maxStrain = in.f64();
+  r.meanCMean = in.f64();
+  r.maxCMean = in.f64();
+  r.maxCMeanFrame = in.i32();
+  r.maxNComp = in.f64();
+  r.stages.clear();
+  const std::size_t n = in.count(24);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::string name = in.str();
+    StageCost& c = r.stages[name];
+    c.totalMs = in.f64();
+    c.frames = in.i64();
+  }
+}
+
+}  // namespace crumple::pipeline

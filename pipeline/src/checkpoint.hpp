@@ -1,0 +1,42 @@
+#pragma once
+// Checkpoint files (issue 8): a shot's whole simulation state after a frame,
+// DIR/checkpoint.bin, written atomically (PATH.tmp, fsync, rename), checked
+// by a CRC32 and by the shot it belongs to (scene text, seed, frame range).
+// Internal to the pipeline; the layout is in docs/CHECKPOINT.md.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "crumple/core/state_io.hpp"
+#include "crumple/io/scene.hpp"
+#include "crumple/pipeline/shot.hpp"
+
+namespace crumple::pipeline {
+
+inline constexpr const char* kCheckpointFile = "checkpoint.bin";
+
+struct Checkpoint {
+  int frame = 0;                 // the last frame the state has simulated
+  std::size_t cachedFrames = 0;  // the cache's frames that go with it
+  std::shared_ptr<const std::vector<std::uint8_t>> bytes;
+  std::unique_ptr<StateReader> state;  // after the head: the stages' sections follow
+};
+
+// The head: which shot, which frame, how many cached frames.
+void writeCheckpointHead(StateWriter& w, const io::SceneSpec& scene, std::uint64_t seed,
+                         int lastFrame, int frame, std::size_t cachedFrames);
+// Writes w's bytes and their CRC to `path` atomically. Throws InputError.
+void writeCheckpointFile(const std::string& path, const StateWriter& w);
+// Reads and checks a checkpoint for this shot. Throws InputError when there
+// is none, when it belongs to another shot (scene, seed or frame range), or
+// when it is damaged (CRC, truncated).
+Checkpoint readCheckpoint(const std::string& path, const io::SceneSpec& scene, std::uint64_t seed,
+                          int lastFrame);
+
+// The report's running counters, so that a resumed run's summary counts the
+// whole shot.
+void saveReport(StateWriter& w, const ShotReport& r);
+void restoreReport(StateReader& in, ShotReport& r);
+
+}  // namespace crumple::pipeline
