@@ -166,4 +166,106 @@ void restoreReport(StateReader& in, ShotReport& r) {
   }
 }
 
+void saveTearingReport(StateWriter& w, const ShotReport& r) {
+  w.tag("TRPT");
+  w.count(r.tearAdvances.size());
+  for (const auto& a : r.tearAdvances) {
+    w.i32(a.frame);
+    const tear::TearEvent& e = a.event;
+    w.i32(e.tear);
+    w.boolean(e.started);
+    w.u8(static_cast<std::uint8_t>(e.kind));
+    w.i32(e.vertex);
+    w.f64(e.energyRelease);
+    w.f64(e.fractureEnergy);
+    w.vec2(e.from);
+    w.vec2(e.to);
+    w.boolean(e.separated);
+  }
+  w.i32(r.firstTearFrame);
+  w.i32(r.tearHandoverFrame);
+  w.i32(r.tearGeometricCuts);
+  w.i32(r.tearRegionsFlattened);
+  w.f64(r.tearMs);
+  w.f64(r.tearBakeMs);
+  w.i64(static_cast<std::int64_t>(r.maxTriangles));
+  w.i64(static_cast<std::int64_t>(r.vertices));
+  w.count(r.notes.size());
+  for (const auto& n : r.notes) w.str(n);
+}
+
+void restoreTearingReport(StateReader& in, ShotReport& r) {
+  in.tag("TRPT");
+  r.tearAdvances.resize(in.count(60));
+  for (auto& a : r.tearAdvances) {
+    a.frame = in.i32();
+    tear::TearEvent& e = a.event;
+    e.tear = in.i32();
+    e.started = in.boolean();
+    const std::uint8_t kind = in.u8();
+    if (kind > static_cast<std::uint8_t>(tear::CandidateKind::InwardCorner))
+      in.fail("a tear advance's kind of " + std::to_string(kind));
+    e.kind = static_cast<tear::CandidateKind>(kind);
+    e.vertex = in.i32();
+    e.energyRelease = in.f64();
+    e.fractureEnergy = in.f64();
+    e.from = in.vec2();
+    e.to = in.vec2();
+    e.separated = in.boolean();
+  }
+  r.firstTearFrame = in.i32();
+  r.tearHandoverFrame = in.i32();
+  r.tearGeometricCuts = in.i32();
+  r.tearRegionsFlattened = in.i32();
+  r.tearMs = in.f64();
+  r.tearBakeMs = in.f64();
+  r.maxTriangles = static_cast<std::size_t>(in.i64());
+  r.vertices = static_cast<std::size_t>(in.i64());
+  r.notes.resize(in.count(8));
+  for (auto& n : r.notes) n = in.str();
+}
+
+void saveSheet(StateWriter& w, const mesh::SheetMesh& m) {
+  w.tag("SHET");
+  w.vec2s(m.pattern);
+  w.triangles(m.triangles);
+  w.i32s(m.regionOfTriangle);
+  w.count(m.regionTypes.size());
+  for (auto t : m.regionTypes) w.u8(static_cast<std::uint8_t>(t));
+}
+
+mesh::SheetMesh restoreSheet(StateReader& in) {
+  in.tag("SHET");
+  mesh::SheetMesh m;
+  m.pattern = in.vec2s();
+  m.triangles = in.triangles();
+  m.regionOfTriangle = in.i32s();
+  m.regionTypes.resize(in.count(1));
+  for (auto& t : m.regionTypes) {
+    const std::uint8_t type = in.u8();
+    if (type > 1) in.fail("a region type of " + std::to_string(type));
+    t = static_cast<mesh::RegionType>(type);
+  }
+  for (const auto& t : m.triangles)
+    for (int v : t)
+      if (v < 0 || static_cast<std::size_t>(v) >= m.pattern.size())
+        in.fail("a triangle's vertex is out of range");
+  m.positions.assign(m.pattern.size(), Vec3::Zero());
+  return m;
+}
+
+void saveBlock(StateWriter& w, const cache::ExtensionBlock& b) {
+  for (char c : b.tag) w.u8(static_cast<std::uint8_t>(c));
+  w.count(b.data.size());
+  for (std::uint8_t x : b.data) w.u8(x);
+}
+
+cache::ExtensionBlock restoreBlock(StateReader& in) {
+  cache::ExtensionBlock b;
+  for (char& c : b.tag) c = static_cast<char>(in.u8());
+  b.data.resize(in.count(1));
+  for (std::uint8_t& x : b.data) x = in.u8();
+  return b;
+}
+
 }  // namespace crumple::pipeline

@@ -38,5 +38,17 @@ Checkpoint readCheckpoint(const std::string& path, const io::SceneSpec& scene, s
 // whole shot.
 void saveReport(StateWriter& w, const ShotReport& r);
 void restoreReport(StateReader& in, ShotReport& r);
+// Its tearing part: every advance (the hand-over replays them, the sound
+// events read the frame's), the tears' frames and counts, and the notes.
+void saveTearingReport(StateWriter& w, const ShotReport& r);
+void restoreTearingReport(StateReader& in, ShotReport& r);
+
+// The elastic model's mesh (pattern, triangles, regions; the positions are
+// the elastic state's).
+void saveSheet(StateWriter& w, const mesh::SheetMesh& m);
+mesh::SheetMesh restoreSheet(StateReader& in);
+// A cache sub-block carried from frame to frame (the baked tear textures).
+void saveBlock(StateWriter& w, const cache::ExtensionBlock& b);
+cache::ExtensionBlock restoreBlock(StateReader& in);
 
 }  // namespace crumple::pipeline

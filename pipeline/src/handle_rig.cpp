@@ -208,4 +208,28 @@ void HandleRig::snap(double t, std::vector<Vec3>& positions) const {
   for (const auto& pin : p) positions[static_cast<std::size_t>(pin.vertex)] = pin.position;
 }
 
+void HandleRig::saveState(StateWriter& out) const {
+  out.tag("RIGS");
+  out.count(handles_.size());
+  for (const auto& h : handles_) {
+    out.i32(h.vertex);
+    out.i32s(h.tangentVertices);
+    out.vec3s(h.tangentOffsets);
+    for (int k = 0; k < 4; ++k) out.f64(h.bindRotation.coeffs()[k]);
+  }
+}
+
+void HandleRig::restoreState(StateReader& in) {
+  in.tag("RIGS");
+  if (in.count(0) != handles_.size()) in.fail("the handles do not match the scene's");
+  for (auto& h : handles_) {
+    h.vertex = in.i32();
+    h.tangentVertices = in.i32s();
+    h.tangentOffsets = in.vec3s();
+    for (int k = 0; k < 4; ++k) h.bindRotation.coeffs()[k] = in.f64();
+    if (h.tangentVertices.size() != h.tangentOffsets.size())
+      in.fail("a handle's tangent vertices do not match their offsets");
+  }
+}
+
 }  // namespace crumple::pipeline

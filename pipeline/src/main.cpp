@@ -15,6 +15,7 @@
 #include "crumple/exporters/pcache.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/io/scene.hpp"
+#include "crumple/pipeline/farm.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/shot.hpp"
 #include "crumple/pipeline/sound.hpp"
@@ -53,6 +54,9 @@ struct Args {
   std::optional<double> gainDb;
   bool noSpectrogram = false;
   bool listEvents = false;
+  // farm
+  pipeline::SlurmOptions slurm;
+  bool dryRun = false;
 };
 
 pipeline::RenderSettings renderSettings(const Args& a) {
@@ -216,6 +220,36 @@ int inspectCommand(const Args& a) {
   return 0;
 }
 
+// `crumple farm slurm`: the shot's sbatch scripts, printed (--dry-run) or
+// written and submitted; `crumple farm movie`: the finalize job's movie.
+int farmCommand(const Args& a, const CLI::App& slurm) {
+  if (!slurm.parsed()) {
+    std::string note;
+    const std::string movie = pipeline::makeShotMovie(a.cache, note);
+    std::printf("movie: %s\n", movie.c_str());
+    if (!note.empty()) std::printf("  note: %s\n", note.c_str());
+    return 0;
+  }
+  const auto s = pipeline::slurmScripts(io::loadScene(io::resolveScenePath(a.scene)), a.slurm);
+  if (a.dryRun) {
+    for (const auto& [name, text] :
+         {std::pair{"simulate", &s.simulate}, std::pair{"render", &s.render},
+          std::pair{"finalize", &s.finalize}})
+      std::printf("# ---- %s/%s.sbatch\n%s", s.farmDir.c_str(), name, text->c_str());
+    std::printf("# ---- submission (dry run: nothing written, nothing submitted)\n%s",
+                pipeline::sbatchCommands(s).c_str());
+    return 0;
+  }
+  const auto jobs = pipeline::submitSlurm(s);
+  std::printf(
+      "simulate job %s\nrender job %s (array 0-%zu: frames %d-%d in chunks of %d)\nfinalize job "
+      "%s\n  scripts: %s/\n  logs:    %s/\n  shot:    %s/\n",
+      jobs.simulate.c_str(), jobs.render.c_str(), s.chunks.size() - 1, s.frames.first,
+      s.frames.last, a.slurm.chunk, jobs.finalize.c_str(), s.farmDir.c_str(), s.logsDir.c_str(),
+      s.outDir.c_str());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -249,7 +283,7 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 256));
     cmd->add_option("--checkpoint-every", a.checkpointEvery,
                     "N: write the whole simulation state to DIR/checkpoint.bin every N frames "
-                    "(atomically); the elastic model without [tear] only, so far")
+                    "(atomically)")
         ->check(CLI::Range(1, 1 << 30));
     cmd->add_flag("--resume", a.resume,
                   "go on from DIR/checkpoint.bin after an interruption: the cache ends "
@@ -315,6 +349,40 @@ int main(int argc, char** argv) {
       "inspect", "Print per-frame sizes, strain, sharpest fold and handle error of a cache.");
   inspect->add_option("CACHE", a.cache, "a .pcache file")->required();
   inspect->add_flag("--json", a.json, "one JSON object for scripts");
+  auto* farm = app.add_subcommand("farm", "Run a shot on a render farm (docs/FARM.md).");
+  farm->require_subcommand(1);
+  auto* farmSlurm = farm->add_subcommand(
+      "slurm",
+      "Write a shot's sbatch scripts into DIR/farm/ and submit them: a simulate job, a render "
+      "job array over frame chunks after it (afterok), a finalize job (soundtrack, movie) after "
+      "the whole array; prints the job ids.");
+  farmSlurm->add_option("SCENE", a.scene, "scene.toml, or a folder holding one")->required();
+  farmSlurm->add_option("--out", a.slurm.outDir,
+                        "the shot folder (default: the scene's [output] dir, else "
+                        "out/<scene name>)");
+  farmSlurm->add_option("--chunk", a.slurm.chunk, "frames per render array task")
+      ->capture_default_str();
+  farmSlurm->add_option("--partition", a.slurm.partition, "sbatch --partition of every job");
+  farmSlurm->add_option("--time", a.slurm.time, "sbatch --time of every job (e.g. 1:00:00)");
+  farmSlurm
+      ->add_option("--cpus-per-task", a.slurm.cpusPerTask,
+                   "sbatch --cpus-per-task of every job, and its crumple --threads")
+      ->check(CLI::PositiveNumber);
+  farmSlurm->add_option("--mem", a.slurm.mem, "sbatch --mem of every job (e.g. 4G)");
+  farmSlurm->add_option("--render-args", a.slurm.renderArgs,
+                        "more `crumple render` arguments for every array task, as one word: "
+                        "--render-args=\"--backend embree --spp 64\"");
+  farmSlurm->add_option("--crumple", a.slurm.crumple,
+                        "the crumple binary the jobs run (default: this one)");
+  farmSlurm->add_flag("--no-movie{false}", a.slurm.movie,
+                      "finalize makes no preview.mp4 (it makes it by default, with ffmpeg)");
+  farmSlurm->add_flag("--dry-run", a.dryRun,
+                      "print the scripts and the sbatch command lines; write and submit nothing");
+  auto* farmMovie = farm->add_subcommand(
+      "movie",
+      "The finalize job's movie: preview.mp4 beside the cache from the frames already in "
+      "frames/ (with sound.wav when there is one), through ffmpeg; renders nothing.");
+  farmMovie->add_option("CACHE", a.cache, "a .pcache file")->required();
 
   try {
     app.parse(argc, argv);
@@ -336,6 +404,7 @@ int main(int argc, char** argv) {
     if (*inspect) return inspectCommand(a);
     if (*soundCmd) return soundCommand(a);
     if (*compare) return compareCommand(a);
+    if (*farm) return farmCommand(a, *farmSlurm);
   } catch (const InputError& e) {
     std::fprintf(stderr, "crumple: error: %s\n", e.what());
     return 2;

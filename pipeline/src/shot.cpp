@@ -210,6 +210,20 @@ constexpr double kLipTolerance = 12.0 * kTearKerf;
 constexpr double kMinStartAngle = 25.0 * std::numbers::pi / 180.0;
 constexpr double kRelaxDt = 1e-4;
 
+// The tearing parameters of the model the sheet runs.
+tear::TearingParams tearingParamsFor(const io::SceneSpec& scene, bool crumplingModel) {
+  tear::TearingParams p = tearingParamsOf(scene.tear);
+  // The crumpling model's cuts are S_G's (paper::cutGeometricMesh), S_P
+  // only finds where they go: over S_P's long curved-region cells the
+  // elastic model's snap would pull short advances back onto the tip.
+  if (crumplingModel) {
+    p.snap = paper::GeometricCutOptions{}.snap;
+    p.minStartAngle = kMinStartAngle;
+    p.maxTurn = paper::GeometricCutOptions{}.maxTurn;
+  }
+  return p;
+}
+
 // The crumpling model's sheet at the elastic model's resolution (a torn
 // sheet handed over, docs/TEARING.md): the scene's rectangle mesh, the
 // vertex nearest each handle's point moved onto it, every vertex placed and
@@ -387,12 +401,6 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   const bool render = options.render && scene.output.frames;
   if (options.checkpointEvery < 0)
     throw InputError("--checkpoint-every", "must be a number of frames >= 1");
-  if ((options.checkpointEvery > 0 || options.resume) &&
-      (scene.model.type == io::ModelSpec::Type::Hybrid || scene.tear.enabled))
-    throw InputError(options.resume ? "--resume" : "--checkpoint-every",
-                     "checkpoints are not written yet for the crumpling model or for tearing "
-                     "(scene " +
-                         scene.file + "); they are for the elastic model without [tear]");
 
   // Everything that can be wrong with the input is checked before any output
   // is written: no partial cache or frames that look valid.
@@ -468,16 +476,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   // Tearing (issue 6): runs only when the scene enables it.
   std::optional<tear::Tearing> tearing;
   if (scene.tear.enabled) {
-    tear::TearingParams tearParams = tearingParamsOf(scene.tear);
-    // The crumpling model's cuts are S_G's (paper::cutGeometricMesh), S_P
-    // only finds where they go: over S_P's long curved-region cells the
-    // elastic model's snap would pull short advances back onto the tip.
-    if (hybrid) {
-      tearParams.snap = paper::GeometricCutOptions{}.snap;
-      tearParams.minStartAngle = kMinStartAngle;
-      tearParams.maxTurn = paper::GeometricCutOptions{}.maxTurn;
-    }
-    tearing.emplace(sheet, tearParams, seed);
+    tearing.emplace(sheet, tearingParamsFor(scene, hybrid != nullptr), seed);
     report.tearingOn = true;
   }
 
@@ -893,7 +892,25 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     StateWriter w;
     writeCheckpointHead(w, scene, seed, range.last, frame, writer->framesWritten());
     saveReport(w, report);
-    elastic->saveState(w);
+    // The model: the crumpling model's layers, or the elastic model on its
+    // (possibly torn) mesh.
+    w.boolean(hybrid != nullptr);
+    if (hybrid) {
+      hybrid->saveState(w);
+    } else {
+      saveSheet(w, sheet);
+      elastic->saveState(w);
+    }
+    rig.saveState(w);
+    w.boolean(tearing.has_value());
+    if (tearing) {
+      tearing->saveState(w);
+      saveTearingReport(w, report);
+      w.boolean(tearAtlasBlock.has_value());
+      if (tearAtlasBlock) saveBlock(w, *tearAtlasBlock);
+      w.triangles(bakedSheet.triangles);
+      w.vec2s(bakedSheet.pattern);
+    }
     w.boolean(soundEvents.has_value());
     if (soundEvents) soundEvents->saveState(w);
     writeCheckpointFile(checkpointPath, w);
@@ -904,7 +921,32 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   if (resumed) {
     StateReader& in = *resumed->state;
     restoreReport(in, report);
-    elastic->restoreState(in);
+    if (in.boolean()) {
+      if (!hybrid) in.fail("holds the crumpling model's state, the scene runs the elastic model");
+      hybrid->restoreState(in);
+    } else {
+      // The elastic model, or a crumpling-model sheet handed over to it.
+      hybrid.reset();
+      sheet = restoreSheet(in);
+      elastic.emplace(sheet, materialOf(scene.paper), params);
+      elastic->setContacts(contact);
+      elastic->restoreState(in);
+      sheet.positions = elastic->positions();
+    }
+    rig.restoreState(in);
+    if (in.boolean() != tearing.has_value())
+      throw InputError(checkpointPath, "was written with a different [tear] setting");
+    if (tearing) {
+      // Made again on the mesh the model has now: after a hand-over, with
+      // the elastic model's parameters.
+      tearing.emplace(hybrid ? hybrid->physical().mesh : sheet,
+                      tearingParamsFor(scene, hybrid != nullptr), seed);
+      tearing->restoreState(in);
+      restoreTearingReport(in, report);
+      if (in.boolean()) tearAtlasBlock = restoreBlock(in);
+      bakedSheet.triangles = in.triangles();
+      bakedSheet.pattern = in.vec2s();
+    }
     if (in.boolean() != soundEvents.has_value())
       throw InputError(checkpointPath, "was written with a different [sound] setting");
     if (soundEvents) soundEvents->restoreState(in);
@@ -946,6 +988,9 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
         carriedContacts.reset();
         if (tearing) tearFrame(frame);
         emit(frame);
+        if (options.checkpointEvery > 0 &&
+            (frame - scene.frameStart) % options.checkpointEvery == 0)
+          checkpoint(frame);
         continue;
       }
       const auto start = Clock::now();

@@ -262,6 +262,179 @@ void HybridSheet::setContacts(sim::ContactOptions options) {
 
 const std::vector<sim::ContactSample>& HybridSheet::contacts() const { return impl_->contacts; }
 
+namespace {
+
+void saveMesh(StateWriter& w, const mesh::SheetMesh& m) {
+  w.vec2s(m.pattern);
+  w.vec3s(m.positions);
+  w.triangles(m.triangles);
+  w.i32s(m.regionOfTriangle);
+  w.count(m.regionTypes.size());
+  for (auto t : m.regionTypes) w.u8(static_cast<std::uint8_t>(t));
+}
+
+mesh::SheetMesh restoreMesh(StateReader& in) {
+  mesh::SheetMesh m;
+  m.pattern = in.vec2s();
+  m.positions = in.vec3s();
+  m.triangles = in.triangles();
+  m.regionOfTriangle = in.i32s();
+  m.regionTypes.resize(in.count(1));
+  for (auto& t : m.regionTypes) {
+    const std::uint8_t type = in.u8();
+    if (type > 1) in.fail("a region type of " + std::to_string(type));
+    t = static_cast<mesh::RegionType>(type);
+  }
+  if (m.positions.size() != m.pattern.size())
+    in.fail("a mesh's positions do not match its pattern");
+  for (const auto& t : m.triangles)
+    for (int v : t)
+      if (v < 0 || static_cast<std::size_t>(v) >= m.pattern.size())
+        in.fail("a triangle's vertex is out of range");
+  return m;
+}
+
+}  // namespace
+
+void HybridSheet::saveState(StateWriter& w) const {
+  const Impl& m = *impl_;
+  w.tag("HYBR");
+  w.f64(m.time);
+  // S_G.
+  w.count(m.sg.vertices.size());
+  for (const auto& v : m.sg.vertices) {
+    w.vec2(v.pattern);
+    w.vec3(v.position);
+    w.vec3(v.velocity);
+    w.boolean(v.onBoundary);
+    w.boolean(v.corner);
+    w.boolean(v.singular);
+    w.boolean(v.handle);
+    w.i32(v.outlineSegment);
+  }
+  w.count(m.sg.faces.size());
+  for (const auto& f : m.sg.faces) {
+    for (int v : f.v) w.i32(v);
+    w.i32(f.region);
+  }
+  w.count(m.sg.regions.size());
+  for (const auto& r : m.sg.regions) {
+    w.u8(static_cast<std::uint8_t>(r.type));
+    w.i32(r.apex);
+    w.count(r.rulings.size());
+    for (const auto& ruling : r.rulings) {
+      w.i32(ruling.a);
+      w.i32(ruling.b);
+    }
+  }
+  w.vec2s(m.sg.outline);
+  // S_P.
+  saveMesh(w, m.sp.mesh);
+  w.count(m.sp.samples.size());
+  for (const auto& s : m.sp.samples) {
+    w.i32(s.face);
+    for (double x : s.weights) w.f64(x);
+  }
+  w.i32s(m.sp.faceOfTriangle);
+  w.vec3s(m.spVelocities);
+  w.count(m.contacts.size());
+  for (const auto& c : m.contacts) {
+    w.i32(c.vertex);
+    w.i32(c.collider);
+    w.f64(c.slideSpeed);
+    w.f64(c.normalForce);
+  }
+  w.count(m.recentCuts.size());
+  for (const auto& [p, left] : m.recentCuts) {
+    w.vec2(p);
+    w.i32(left);
+  }
+  m.elastic->saveState(w);
+}
+
+void HybridSheet::restoreState(StateReader& in) {
+  Impl& m = *impl_;
+  in.tag("HYBR");
+  const double time = in.f64();
+  GeometricMesh sg;
+  sg.vertices.resize(in.count(61));
+  for (auto& v : sg.vertices) {
+    v.pattern = in.vec2();
+    v.position = in.vec3();
+    v.velocity = in.vec3();
+    v.onBoundary = in.boolean();
+    v.corner = in.boolean();
+    v.singular = in.boolean();
+    v.handle = in.boolean();
+    v.outlineSegment = in.i32();
+  }
+  sg.faces.resize(in.count(20));
+  for (auto& f : sg.faces) {
+    for (int& v : f.v) v = in.i32();
+    f.region = in.i32();
+  }
+  sg.regions.resize(in.count(13));
+  for (auto& r : sg.regions) {
+    const std::uint8_t type = in.u8();
+    if (type > 1) in.fail("a region type of " + std::to_string(type));
+    r.type = static_cast<mesh::RegionType>(type);
+    r.apex = in.i32();
+    r.rulings.resize(in.count(8));
+    for (auto& ruling : r.rulings) {
+      ruling.a = in.i32();
+      ruling.b = in.i32();
+    }
+  }
+  sg.outline = in.vec2s();
+  const auto vertexOk = [&](int v) {
+    return v >= 0 && static_cast<std::size_t>(v) < sg.vertices.size();
+  };
+  for (const auto& f : sg.faces) {
+    for (int k = 0; k < f.size(); ++k)
+      if (!vertexOk(f.v[static_cast<std::size_t>(k)])) in.fail("a face's vertex is out of range");
+    if (f.region < 0 || static_cast<std::size_t>(f.region) >= sg.regions.size())
+      in.fail("a face's region is out of range");
+  }
+  for (const auto& r : sg.regions) {
+    if (r.apex != -1 && !vertexOk(r.apex)) in.fail("a region's apex is out of range");
+    for (const auto& ruling : r.rulings)
+      if (!vertexOk(ruling.a) || !vertexOk(ruling.b)) in.fail("a ruling's vertex is out of range");
+  }
+  PhysicalMesh sp;
+  sp.mesh = restoreMesh(in);
+  sp.samples.resize(in.count(36));
+  for (auto& s : sp.samples) {
+    s.face = in.i32();
+    for (double& x : s.weights) x = in.f64();
+  }
+  sp.faceOfTriangle = in.i32s();
+  std::vector<Vec3> velocities = in.vec3s();
+  if (velocities.size() != sp.mesh.vertexCount())
+    in.fail("the physical layer's velocities do not match its vertices");
+  std::vector<sim::ContactSample> contacts(in.count(24));
+  for (auto& c : contacts) {
+    c.vertex = in.i32();
+    c.collider = in.i32();
+    c.slideSpeed = in.f64();
+    c.normalForce = in.f64();
+  }
+  std::vector<std::pair<Vec2, int>> recentCuts(in.count(20));
+  for (auto& [p, left] : recentCuts) {
+    p = in.vec2();
+    left = in.i32();
+  }
+  m.sg = std::move(sg);
+  m.sp = std::move(sp);
+  m.spVelocities = std::move(velocities);
+  m.contacts = std::move(contacts);
+  m.recentCuts = std::move(recentCuts);
+  m.time = time;
+  m.isometry.reset();
+  m.elastic.emplace(m.sp.mesh, m.material, m.simParams);
+  m.elastic->setContacts(m.contact);
+  m.elastic->restoreState(in);
+}
+
 // Issue 6, thesis 3.3.3 "Remeshing" (Figs. 3.20-3.23).
 std::optional<std::vector<GeometricCutResult>> HybridSheet::tear(
     const std::vector<TearAdvance>& advances, const GeometricCutOptions& options) {

@@ -396,4 +396,41 @@ std::vector<Vec3> blendValues(const std::vector<Vec3>& values,
   return out;
 }
 
+void Tearing::saveState(StateWriter& out) const {
+  out.tag("TEAR");
+  out.f64(edgeLength_);
+  out.i32s(tips_);
+  out.bytes(lip_);
+  out.count(startKinds_.size());
+  for (auto k : startKinds_) out.u8(static_cast<std::uint8_t>(k));
+  out.count(segments_.size());
+  for (const auto& s : segments_) {
+    out.i32(s.tear);
+    out.vec2s(s.cut);
+    out.vec2s(s.detail);
+  }
+}
+
+void Tearing::restoreState(StateReader& in) {
+  in.tag("TEAR");
+  edgeLength_ = in.f64();
+  if (!(edgeLength_ > 0.0)) in.fail("a non-positive edge length");
+  tips_ = in.i32s();
+  lip_ = in.bytes();
+  startKinds_.resize(in.count(1));
+  for (auto& k : startKinds_) {
+    const std::uint8_t kind = in.u8();
+    if (kind > static_cast<std::uint8_t>(CandidateKind::InwardCorner))
+      in.fail("a tear's start kind of " + std::to_string(kind));
+    k = static_cast<CandidateKind>(kind);
+  }
+  segments_.resize(in.count(20));
+  for (auto& s : segments_) {
+    s.tear = in.i32();
+    s.cut = in.vec2s();
+    s.detail = in.vec2s();
+  }
+  if (tips_.size() != startKinds_.size()) in.fail("the tears' tips do not match their starts");
+}
+
 }  // namespace crumple::tear

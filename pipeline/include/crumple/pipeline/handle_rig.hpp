@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "crumple/core/state_io.hpp"
 #include "crumple/core/types.hpp"
 #include "crumple/io/animation.hpp"
 #include "crumple/io/scene.hpp"
@@ -59,6 +60,11 @@ class HandleRig {
   void rebind(const mesh::SheetMesh& sheet, const std::vector<int>& handleVertices, double t);
   // Moves pinned vertices onto their targets (called once before simulation).
   void snap(double t, std::vector<Vec3>& positions) const;
+  // Checkpoint and resume (issue 8): each handle's vertex, tangent-plane
+  // vertices and offsets and bind rotation, for a rig bound again from the
+  // same scene. restoreState throws CorruptDataError for another rig's.
+  void saveState(StateWriter& out) const;
+  void restoreState(StateReader& in);
 
  private:
   const io::AnimationScene* animation_;

@@ -53,7 +53,7 @@ struct ShotOptions {
   // Checkpoint and resume (issue 8): every this many frames (0: never) the
   // whole simulation state goes to DIR/checkpoint.bin, atomically; `resume`
   // goes on from it, and the cache ends byte-identical to an uninterrupted
-  // run's. The elastic model without tearing only, so far.
+  // run's (docs/CHECKPOINT.md).
   int checkpointEvery = 0;
   bool resume = false;
 };

@@ -118,6 +118,15 @@ class HybridSheet {
   int singularVertexCount() const;
   int interiorSingularVertexCount() const;
 
+  // Checkpoint and resume (issue 8): S_G, S_P with its samples, the
+  // velocities, the time, the contacts, the remeshing cooldowns and the
+  // elastic model's state, written for a sheet built again from the same
+  // scene (same material, parameters and seed). restoreState rebuilds the
+  // elastic model on the restored S_P; it throws CorruptDataError for a
+  // malformed state.
+  void saveState(StateWriter& out) const;
+  void restoreState(StateReader& in);
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

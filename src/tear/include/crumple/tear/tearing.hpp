@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "crumple/core/state_io.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/tear/cut.hpp"
 #include "crumple/tear/detail_path.hpp"
@@ -122,6 +123,14 @@ class Tearing {
   const std::vector<CandidateKind>& startKinds() const { return startKinds_; }
   const FiberTexture& fibers() const { return fibers_; }
   double edgeLength() const { return edgeLength_; }
+
+  // Checkpoint and resume (issue 8): the tears (tips, lips, start kinds,
+  // every advance) and the edge length the advances are measured in, for a
+  // Tearing made again with the same parameters and seed on a mesh of the
+  // same pattern (its fiber texture depends on those only). restoreState
+  // throws CorruptDataError for a malformed state.
+  void saveState(StateWriter& out) const;
+  void restoreState(StateReader& in);
 
  private:
   // Cuts `mesh` from `vertex` to `to` as event `e` (e.tear < 0: a new
