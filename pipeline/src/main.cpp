@@ -15,6 +15,7 @@
 #include "crumple/exporters/pcache.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/io/scene.hpp"
+#include "crumple/pipeline/export.hpp"
 #include "crumple/pipeline/farm.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/shot.hpp"
@@ -54,6 +55,8 @@ struct Args {
   std::optional<double> gainDb;
   bool noSpectrogram = false;
   bool listEvents = false;
+  // export
+  std::string exportFormat;
   // farm
   pipeline::SlurmOptions slurm;
   bool dryRun = false;
@@ -213,6 +216,21 @@ int compareCommand(const Args& a) {
   return ok ? 0 : 1;
 }
 
+// `crumple export`: the cached frames as OBJ, PLY, glTF or USDA files.
+int exportCommand(const Args& a) {
+  pipeline::ExportOptions options;
+  options.format = pipeline::parseExportFormat(a.exportFormat);
+  options.outDir = a.out;
+  if (!a.frames.empty()) options.frames = pipeline::parseFrameRange(a.frames);
+  const auto r = pipeline::exportCache(a.cache, options);
+  std::printf("%d frames exported as %s (%zu files) in %.1f ms\n  folder:  %s/\n", r.frames,
+              pipeline::exportFormatName(options.format), r.files.size(), r.ms,
+              r.outDir.c_str());
+  if (r.tornFrames > 0) std::printf("  tears:   %d frames with a tear texture\n", r.tornFrames);
+  for (const auto& n : r.notes) std::printf("  note: %s\n", n.c_str());
+  return 0;
+}
+
 int inspectCommand(const Args& a) {
   const cache::CacheReader reader(a.cache);
   std::fputs((a.json ? pipeline::inspectJson(reader) : pipeline::inspectText(reader)).c_str(),
@@ -349,6 +367,18 @@ int main(int argc, char** argv) {
       "inspect", "Print per-frame sizes, strain, sharpest fold and handle error of a cache.");
   inspect->add_option("CACHE", a.cache, "a .pcache file")->required();
   inspect->add_flag("--json", a.json, "one JSON object for scripts");
+  auto* exportCmd = app.add_subcommand(
+      "export",
+      "Export cached frames for DCC tools (docs/EXPORT.md): obj (NNNN.obj + .mtl, UVs = the "
+      "pattern, torn frames cut by NNNN_tears.png), ply (binary NNNN.ply, UVs, region per face), "
+      "gltf (NNNN.glb, and shot.glb with every frame as a node shown only on its frame) or usda "
+      "(shot.usda, a time-varying Mesh). Needs only the cache.");
+  exportCmd->add_option("CACHE", a.cache, "a .pcache file")->required();
+  exportCmd->add_option("--format", a.exportFormat, "obj, ply, gltf or usda")->required();
+  exportCmd->add_option("--out", a.out,
+                        "output folder (default: export/<format>/ beside the cache)");
+  exportCmd->add_option("--frames", a.frames,
+                        "A-B: frames to export (default: every cached frame)");
   auto* farm = app.add_subcommand("farm", "Run a shot on a render farm (docs/FARM.md).");
   farm->require_subcommand(1);
   auto* farmSlurm = farm->add_subcommand(
@@ -404,6 +434,7 @@ int main(int argc, char** argv) {
     if (*inspect) return inspectCommand(a);
     if (*soundCmd) return soundCommand(a);
     if (*compare) return compareCommand(a);
+    if (*exportCmd) return exportCommand(a);
     if (*farm) return farmCommand(a, *farmSlurm);
   } catch (const InputError& e) {
     std::fprintf(stderr, "crumple: error: %s\n", e.what());

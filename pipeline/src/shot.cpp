@@ -574,6 +574,9 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
         record.junctionVertices.clear();
         record.triangles = sheet.triangles;
         record.regionOfTriangle = sheet.regionOfTriangle;
+        record.regionTypes.clear();  // a handed-over sheet's are the elastic mesh's, not S_P's
+        for (auto type : sheet.regionTypes)
+          record.regionTypes.push_back(static_cast<std::uint8_t>(type));
         record.pattern = sheet.pattern;
         report.maxTriangles = std::max(report.maxTriangles, sheet.triangleCount());
       }
@@ -900,6 +903,9 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     } else {
       saveSheet(w, sheet);
       elastic->saveState(w);
+      // A crumpling-model sheet handed over keeps its singular vertices in
+      // the cache's frames (same indices).
+      w.i32s(record.singularVertices);
     }
     rig.saveState(w);
     w.boolean(tearing.has_value());
@@ -932,6 +938,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
       elastic->setContacts(contact);
       elastic->restoreState(in);
       sheet.positions = elastic->positions();
+      record.singularVertices = in.i32s();
     }
     rig.restoreState(in);
     if (in.boolean() != tearing.has_value())

@@ -14,7 +14,8 @@ using namespace crumple::testing;
 TEST(Cli, HelpForEverySubcommand) {
   const auto top = runCrumple("--help");
   EXPECT_EQ(top.status, 0);
-  for (const char* sub : {"run", "simulate", "render", "sound", "inspect", "compare"}) {
+  for (const char* sub :
+       {"run", "simulate", "render", "sound", "export", "farm", "inspect", "compare"}) {
     EXPECT_NE(top.output.find(sub), std::string::npos) << sub;
     const auto r = runCrumple(std::string(sub) + " --help");
     EXPECT_EQ(r.status, 0) << sub;
