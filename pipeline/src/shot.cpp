@@ -1,5 +1,7 @@
 #include "crumple/pipeline/shot.hpp"
 
+#include <unistd.h>
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <charconv>
@@ -387,6 +389,25 @@ mesh::SheetMesh buildSheet(const io::SceneSpec& scene, const io::AnimationScene*
     throw InputError(scene.file, "[sheet] pattern_mesh '" + s.patternMesh + "': " + problem);
   return sheet;
 }
+
+namespace {
+
+// summary.json, and for a farm's log (not a terminal) the same JSON on one
+// final `SUMMARY {...}` line after the PROGRESS lines (issue 8, item 6).
+void writeSummary(const io::SceneSpec& scene, const ShotReport& report,
+                  const ShotOptions& options) {
+  const std::string json = summaryJson(scene, report);
+  writeTextAtomically(report.summaryPath, json);
+  const bool terminal = options.interactive < 0
+                            ? options.log != nullptr && ::isatty(::fileno(options.log)) != 0
+                            : options.interactive != 0;
+  if (options.log != nullptr && !terminal) {
+    std::fprintf(options.log, "SUMMARY %s\n", json.c_str());
+    std::fflush(options.log);
+  }
+}
+
+}  // namespace
 
 ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   ShotReport report;
@@ -1030,7 +1051,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     report.hybrid = hybridModel;
     if (report.framesSimulated > 0) report.meanCMean /= report.framesSimulated;
     writer->close();  // the cache stays valid up to the last good frame
-    writeTextAtomically(report.summaryPath, summaryJson(scene, report));
+    writeSummary(scene, report, options);
     throw;
   }
   progress.finish();
@@ -1069,7 +1090,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     report.warnings.push_back("the elastic solve halved its substep " +
                               std::to_string(report.halvings) +
                               " times; consider more [scene] substeps");
-  writeTextAtomically(report.summaryPath, summaryJson(scene, report));
+  writeSummary(scene, report, options);
   return report;
 }
 

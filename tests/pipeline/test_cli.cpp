@@ -52,6 +52,11 @@ TEST(Cli, RunWritesCacheFramesSummaryAndProgressLines) {
   EXPECT_NE(r.output.find("ms/frame"), std::string::npos);
   const auto summary = readFile(tmp / "out/summary.json");
   EXPECT_NE(summary.find("\"elastic\""), std::string::npos);
+  // For a farm's log: the same JSON on one `SUMMARY` line after the progress.
+  const auto line = r.output.find("SUMMARY {");
+  ASSERT_NE(line, std::string::npos) << r.output;
+  EXPECT_GT(line, r.output.rfind("PROGRESS "));
+  EXPECT_EQ(r.output.substr(line + 8, summary.size()), summary);
   EXPECT_NE(summary.find("\"tearing\":false"), std::string::npos);
   // The derived stiffnesses of the preset: E h / (1 - nu^2), E h^3 / (12 (1 - nu^2)).
   EXPECT_NE(summary.find("\"stretch_stiffness_N_m\":384000"), std::string::npos) << summary;
