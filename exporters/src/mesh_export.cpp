@@ -55,25 +55,6 @@ void putI32(std::string& out, std::int32_t v) {
   for (int k = 0; k < 4; ++k) out.push_back(static_cast<char>((bits >> (8 * k)) & 0xffu));
 }
 
-// The renderers' mask lookup (render::sampleTearMask): bilinear between
-// texel centres at + 0.5, clamped to the atlas; in [0, 1].
-double sampleMask(const mesh::TearAtlas& atlas, const Vec2& position) {
-  const int w = atlas.width, h = atlas.height;
-  const double x = position.x() - 0.5, y = position.y() - 0.5;
-  const double fx = std::floor(x), fy = std::floor(y);
-  const double ax = x - fx, ay = y - fy;
-  const auto clampTo = [](double i, int n) {
-    return static_cast<std::size_t>(std::clamp(i, 0.0, static_cast<double>(n - 1)));
-  };
-  const std::size_t x0 = clampTo(fx, w), x1 = clampTo(fx + 1.0, w);
-  const std::size_t y0 = clampTo(fy, h), y1 = clampTo(fy + 1.0, h);
-  const auto texel = [&](std::size_t xi, std::size_t yi) {
-    return atlas.mask[yi * static_cast<std::size_t>(w) + xi] / 255.0;
-  };
-  return (1.0 - ay) * ((1.0 - ax) * texel(x0, y0) + ax * texel(x1, y0)) +
-         ay * ((1.0 - ax) * texel(x0, y1) + ax * texel(x1, y1));
-}
-
 // Twice the signed area of (a, b, c).
 double cross2(const Vec2& a, const Vec2& b, const Vec2& c) {
   return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
@@ -293,7 +274,7 @@ std::optional<ImageRGBA8> tearTexture(const cache::FrameRecord& frame, const UvM
         const double b1 = cross2(p[2], p[0], q) / area;
         const double b2 = cross2(p[0], p[1], q) / area;
         if (b0 < 0.0 || b1 < 0.0 || b2 < 0.0) continue;
-        const double value = sampleMask(*atlas, mesh::atlasPosition(*atlas, patch, q));
+        const double value = mesh::sampleTearMask(*atlas, mesh::atlasPosition(*atlas, patch, q));
         const auto a = static_cast<std::uint8_t>(std::lround(255.0 * std::clamp(value, 0.0, 1.0)));
         std::uint8_t* px = image.at(i, r);
         px[0] = px[1] = px[2] = px[3] = a;

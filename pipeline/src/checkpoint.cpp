@@ -225,35 +225,6 @@ void restoreTearingReport(StateReader& in, ShotReport& r) {
   for (auto& n : r.notes) n = in.str();
 }
 
-void saveSheet(StateWriter& w, const mesh::SheetMesh& m) {
-  w.tag("SHET");
-  w.vec2s(m.pattern);
-  w.triangles(m.triangles);
-  w.i32s(m.regionOfTriangle);
-  w.count(m.regionTypes.size());
-  for (auto t : m.regionTypes) w.u8(static_cast<std::uint8_t>(t));
-}
-
-mesh::SheetMesh restoreSheet(StateReader& in) {
-  in.tag("SHET");
-  mesh::SheetMesh m;
-  m.pattern = in.vec2s();
-  m.triangles = in.triangles();
-  m.regionOfTriangle = in.i32s();
-  m.regionTypes.resize(in.count(1));
-  for (auto& t : m.regionTypes) {
-    const std::uint8_t type = in.u8();
-    if (type > 1) in.fail("a region type of " + std::to_string(type));
-    t = static_cast<mesh::RegionType>(type);
-  }
-  for (const auto& t : m.triangles)
-    for (int v : t)
-      if (v < 0 || static_cast<std::size_t>(v) >= m.pattern.size())
-        in.fail("a triangle's vertex is out of range");
-  m.positions.assign(m.pattern.size(), Vec3::Zero());
-  return m;
-}
-
 void saveBlock(StateWriter& w, const cache::ExtensionBlock& b) {
   for (char c : b.tag) w.u8(static_cast<std::uint8_t>(c));
   w.count(b.data.size());

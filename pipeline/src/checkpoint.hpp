@@ -43,10 +43,6 @@ void restoreReport(StateReader& in, ShotReport& r);
 void saveTearingReport(StateWriter& w, const ShotReport& r);
 void restoreTearingReport(StateReader& in, ShotReport& r);
 
-// The elastic model's mesh (pattern, triangles, regions; the positions are
-// the elastic state's).
-void saveSheet(StateWriter& w, const mesh::SheetMesh& m);
-mesh::SheetMesh restoreSheet(StateReader& in);
 // A cache sub-block carried from frame to frame (the baked tear textures).
 void saveBlock(StateWriter& w, const cache::ExtensionBlock& b);
 cache::ExtensionBlock restoreBlock(StateReader& in);

@@ -922,7 +922,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     if (hybrid) {
       hybrid->saveState(w);
     } else {
-      saveSheet(w, sheet);
+      mesh::saveSheetMesh(w, sheet);
       elastic->saveState(w);
       // A crumpling-model sheet handed over keeps its singular vertices in
       // the cache's frames (same indices).
@@ -954,7 +954,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     } else {
       // The elastic model, or a crumpling-model sheet handed over to it.
       hybrid.reset();
-      sheet = restoreSheet(in);
+      sheet = mesh::restoreSheetMesh(in);
       elastic.emplace(sheet, materialOf(scene.paper), params);
       elastic->setContacts(contact);
       elastic->restoreState(in);

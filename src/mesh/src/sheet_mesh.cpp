@@ -151,4 +151,38 @@ std::string validate(const SheetMesh& mesh) {
   return {};
 }
 
+void saveSheetMesh(StateWriter& w, const SheetMesh& m) {
+  w.tag("MESH");
+  w.vec2s(m.pattern);
+  w.vec3s(m.positions);
+  w.triangles(m.triangles);
+  w.i32s(m.regionOfTriangle);
+  w.count(m.regionTypes.size());
+  for (auto t : m.regionTypes) w.u8(static_cast<std::uint8_t>(t));
+}
+
+SheetMesh restoreSheetMesh(StateReader& in) {
+  in.tag("MESH");
+  SheetMesh m;
+  m.pattern = in.vec2s();
+  m.positions = in.vec3s();
+  m.triangles = in.triangles();
+  m.regionOfTriangle = in.i32s();
+  m.regionTypes.resize(in.count(1));
+  for (auto& t : m.regionTypes) {
+    const std::uint8_t type = in.u8();
+    if (type > 1) in.fail("a region type of " + std::to_string(type));
+    t = static_cast<RegionType>(type);
+  }
+  if (m.positions.size() != m.pattern.size())
+    in.fail("a mesh's positions do not match its pattern");
+  if (!m.regionOfTriangle.empty() && m.regionOfTriangle.size() != m.triangles.size())
+    in.fail("a mesh's regions do not match its triangles");
+  for (const auto& t : m.triangles)
+    for (int v : t)
+      if (v < 0 || static_cast<std::size_t>(v) >= m.pattern.size())
+        in.fail("a triangle's vertex is out of range");
+  return m;
+}
+
 }  // namespace crumple::mesh

@@ -262,40 +262,6 @@ void HybridSheet::setContacts(sim::ContactOptions options) {
 
 const std::vector<sim::ContactSample>& HybridSheet::contacts() const { return impl_->contacts; }
 
-namespace {
-
-void saveMesh(StateWriter& w, const mesh::SheetMesh& m) {
-  w.vec2s(m.pattern);
-  w.vec3s(m.positions);
-  w.triangles(m.triangles);
-  w.i32s(m.regionOfTriangle);
-  w.count(m.regionTypes.size());
-  for (auto t : m.regionTypes) w.u8(static_cast<std::uint8_t>(t));
-}
-
-mesh::SheetMesh restoreMesh(StateReader& in) {
-  mesh::SheetMesh m;
-  m.pattern = in.vec2s();
-  m.positions = in.vec3s();
-  m.triangles = in.triangles();
-  m.regionOfTriangle = in.i32s();
-  m.regionTypes.resize(in.count(1));
-  for (auto& t : m.regionTypes) {
-    const std::uint8_t type = in.u8();
-    if (type > 1) in.fail("a region type of " + std::to_string(type));
-    t = static_cast<mesh::RegionType>(type);
-  }
-  if (m.positions.size() != m.pattern.size())
-    in.fail("a mesh's positions do not match its pattern");
-  for (const auto& t : m.triangles)
-    for (int v : t)
-      if (v < 0 || static_cast<std::size_t>(v) >= m.pattern.size())
-        in.fail("a triangle's vertex is out of range");
-  return m;
-}
-
-}  // namespace
-
 void HybridSheet::saveState(StateWriter& w) const {
   const Impl& m = *impl_;
   w.tag("HYBR");
@@ -329,7 +295,7 @@ void HybridSheet::saveState(StateWriter& w) const {
   }
   w.vec2s(m.sg.outline);
   // S_P.
-  saveMesh(w, m.sp.mesh);
+  mesh::saveSheetMesh(w, m.sp.mesh);
   w.count(m.sp.samples.size());
   for (const auto& s : m.sp.samples) {
     w.i32(s.face);
@@ -401,7 +367,7 @@ void HybridSheet::restoreState(StateReader& in) {
       if (!vertexOk(ruling.a) || !vertexOk(ruling.b)) in.fail("a ruling's vertex is out of range");
   }
   PhysicalMesh sp;
-  sp.mesh = restoreMesh(in);
+  sp.mesh = mesh::restoreSheetMesh(in);
   sp.samples.resize(in.count(36));
   for (auto& s : sp.samples) {
     s.face = in.i32();

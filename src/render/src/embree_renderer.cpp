@@ -151,7 +151,7 @@ void alphaCutFilter(const RTCFilterFunctionNArguments* args) {
     const float v = RTCHitN_v(args->hit, args->N, i);
     const SheetTri& t = look->tris[prim];
     if (sampleTexture(*look->texture, sheetUv(t, u, v)).w() < 0.5 ||
-        (t.masked && sampleTearMask(*look->tears, interpolate(t.maskUv, u, v)) < 0.5))
+        (t.masked && mesh::sampleTearMask(*look->tears, interpolate(t.maskUv, u, v)) < 0.5))
       args->valid[i] = 0;
   }
 }

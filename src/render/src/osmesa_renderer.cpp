@@ -724,7 +724,7 @@ struct OsmesaRenderer::Impl {
   }
 
   // The tear atlas's mask as a single-channel texture on kMaskUnit (GL_LINEAR,
-  // clamped, level 0 only: sampleTearMask's lookup).
+  // clamped, level 0 only: mesh::sampleTearMask's lookup).
   void uploadMask(const mesh::TearAtlas& atlas) {
     glActiveTexture(GL_TEXTURE0 + kMaskUnit);
     glBindTexture(GL_TEXTURE_2D, maskTex);

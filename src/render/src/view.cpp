@@ -277,24 +277,6 @@ Vec4 sampleTexture(const ImageRGBA8& texture, const Vec2& uv) {
          ay * ((1.0 - ax) * texel(x0, y1) + ax * texel(x1, y1));
 }
 
-double sampleTearMask(const mesh::TearAtlas& atlas, const Vec2& position) {
-  const int w = atlas.width, h = atlas.height;
-  if (w <= 0 || h <= 0) return 1.0;
-  const double x = position.x() - 0.5, y = position.y() - 0.5;
-  const double fx = std::floor(x), fy = std::floor(y);
-  const double ax = x - fx, ay = y - fy;
-  const auto clampTo = [](double i, int n) {
-    return static_cast<std::size_t>(std::clamp(i, 0.0, static_cast<double>(n - 1)));
-  };
-  const std::size_t x0 = clampTo(fx, w), x1 = clampTo(fx + 1.0, w);
-  const std::size_t y0 = clampTo(fy, h), y1 = clampTo(fy + 1.0, h);
-  const auto texel = [&](std::size_t xi, std::size_t yi) {
-    return atlas.mask[yi * static_cast<std::size_t>(w) + xi] / 255.0;
-  };
-  return (1.0 - ay) * ((1.0 - ax) * texel(x0, y0) + ax * texel(x1, y0)) +
-         ay * ((1.0 - ax) * texel(x0, y1) + ax * texel(x1, y1));
-}
-
 void validateRenderInput(const RenderScene& scene, const mesh::SheetMesh& sheet, const char* who) {
   const auto invalid = [who](const std::string& what) {
     throw std::invalid_argument(std::string(who) + ": " + what);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "crumple/core/state_io.hpp"
 #include "crumple/core/types.hpp"
 
 namespace crumple::mesh {
@@ -39,6 +40,12 @@ struct MeshEdge {
 // All edges sorted by (v0, v1). Throws std::invalid_argument on a
 // non-manifold edge (three or more triangles).
 std::vector<MeshEdge> buildEdges(const SheetMesh& mesh);
+
+// Checkpoint and resume (issue 8): the whole mesh (pattern, positions,
+// triangles, regions) in a state; restoreSheetMesh throws CorruptDataError
+// for indices out of range or sizes that do not match.
+void saveSheetMesh(StateWriter& out, const SheetMesh& mesh);
+SheetMesh restoreSheetMesh(StateReader& in);
 
 // A width x height rectangle in the pattern, [0,width] x [0,height], meshed as
 // a regular grid whose cells are split into four triangles at their centre

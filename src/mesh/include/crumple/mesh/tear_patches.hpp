@@ -74,6 +74,12 @@ struct TearAtlas {
 // texel (x, y) covers [x, x + 1) x [y, y + 1).
 Vec2 atlasPosition(const TearAtlas& atlas, const TearPatch& patch, const Vec2& p);
 
+// Bilinear lookup of a tear atlas's mask as OpenGL does it with GL_LINEAR
+// and GL_CLAMP_TO_EDGE at level 0, at an atlas position in texels
+// (atlasPosition; texel centres at x + 0.5): in [0, 1]; 1 for an empty
+// atlas. What the renderers and the exports cut the paper with.
+double sampleTearMask(const TearAtlas& atlas, const Vec2& position);
+
 // A corner of one of a patch's triangles.
 struct TearPatchVertex {
   Vec3 position = Vec3::Zero();  // m, this frame

@@ -190,7 +190,7 @@ struct RenderScene {
   // This frame's tear textures (docs/RENDERING.md "Tears"; thesis 3.3.4):
   // each patch is drawn instead of its triangle, the triangle and its
   // support quads (mesh::tearPatchTriangles), and the paper is cut where the
-  // patch's mask (sampleTearMask) is below 0.5 as where the texture's alpha
+  // patch's mask (mesh::sampleTearMask) is below 0.5 as where the texture's alpha
   // is, for camera, bounce and shadow rays. Empty: the sheet as it is. The
   // preview's structure view with triangle colours shows the mesh without
   // them.
@@ -219,12 +219,6 @@ std::vector<std::array<Vec3, 3>> shadingNormals(const std::vector<Vec3>& positio
 // first row in memory, i.e. the image's top row): linear RGB (each texel
 // decoded before filtering, like GL_SRGB8_ALPHA8) and alpha in [0, 1].
 Vec4 sampleTexture(const ImageRGBA8& texture, const Vec2& uv);
-
-// Bilinear lookup of a tear atlas's mask as OpenGL does it with GL_LINEAR
-// and GL_CLAMP_TO_EDGE at level 0, at an atlas position in texels
-// (mesh::atlasPosition; texel centres at x + 0.5): in [0, 1]; 1 for an
-// empty atlas.
-double sampleTearMask(const mesh::TearAtlas& atlas, const Vec2& position);
 
 // The checks both renderers make before drawing (std::invalid_argument
 // "<who>: <what is wrong>"): a finite camera with 0 < yfov < pi, 0 < znear <
