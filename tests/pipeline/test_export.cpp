@@ -23,29 +23,18 @@
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/export.hpp"
 #include "crumple/pipeline/shot.hpp"
+#include "sample_shot.hpp"
 #include "test_util.hpp"
 
 using namespace crumple;
 using crumple::testing::readFile;
 using crumple::testing::runCrumple;
+using crumple::testing::simulateSample;
 using crumple::testing::sourcePath;
 using crumple::testing::TempDir;
 namespace fs = std::filesystem;
 
 namespace {
-
-// Simulates a sample quietly into dir/NAME (up to frame `last` when >= 0);
-// returns its cache's path.
-std::string simulateSample(const std::string& sample, const TempDir& dir, int last = -1) {
-  const io::SceneSpec scene = io::loadScene(io::resolveScenePath(sourcePath("samples/" + sample)));
-  pipeline::ShotOptions options;
-  options.outDir = (dir / sample).string();
-  options.render = false;
-  options.log = nullptr;
-  options.interactive = 0;
-  if (last >= 0) options.frames = pipeline::FrameRange{scene.frameStart, last};
-  return pipeline::runShot(scene, options).cachePath;
-}
 
 std::string stem(int frame) {
   char buf[32];

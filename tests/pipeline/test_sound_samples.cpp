@@ -22,27 +22,18 @@
 #include "crumple/sound/soundtrack.hpp"
 #include "crumple/sound/spectrogram.hpp"
 #include "crumple/sound/wav.hpp"
+#include "sample_shot.hpp"
 #include "test_util.hpp"
 
 using namespace crumple;
 using crumple::testing::readFile;
 using crumple::testing::runCrumple;
+using crumple::testing::simulateSample;
 using crumple::testing::sourcePath;
 using crumple::testing::TempDir;
 namespace fs = std::filesystem;
 
 namespace {
-
-// Simulates a sample quietly into dir/NAME; returns its cache's path.
-std::string simulateSample(const std::string& sample, const TempDir& dir) {
-  const io::SceneSpec scene = io::loadScene(io::resolveScenePath(sourcePath("samples/" + sample)));
-  pipeline::ShotOptions options;
-  options.outDir = (dir / sample).string();
-  options.render = false;
-  options.log = nullptr;
-  options.interactive = 0;
-  return pipeline::runShot(scene, options).cachePath;
-}
 
 struct CachedEvents {
   std::vector<int> frames;  // frame number per cached frame
