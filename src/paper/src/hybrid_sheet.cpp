@@ -303,13 +303,7 @@ void HybridSheet::saveState(StateWriter& w) const {
   }
   w.i32s(m.sp.faceOfTriangle);
   w.vec3s(m.spVelocities);
-  w.count(m.contacts.size());
-  for (const auto& c : m.contacts) {
-    w.i32(c.vertex);
-    w.i32(c.collider);
-    w.f64(c.slideSpeed);
-    w.f64(c.normalForce);
-  }
+  sim::saveContactSamples(w, m.contacts);
   w.count(m.recentCuts.size());
   for (const auto& [p, left] : m.recentCuts) {
     w.vec2(p);
@@ -377,13 +371,7 @@ void HybridSheet::restoreState(StateReader& in) {
   std::vector<Vec3> velocities = in.vec3s();
   if (velocities.size() != sp.mesh.vertexCount())
     in.fail("the physical layer's velocities do not match its vertices");
-  std::vector<sim::ContactSample> contacts(in.count(24));
-  for (auto& c : contacts) {
-    c.vertex = in.i32();
-    c.collider = in.i32();
-    c.slideSpeed = in.f64();
-    c.normalForce = in.f64();
-  }
+  std::vector<sim::ContactSample> contacts = sim::restoreContactSamples(in, sp.mesh.vertexCount());
   std::vector<std::pair<Vec2, int>> recentCuts(in.count(20));
   for (auto& [p, left] : recentCuts) {
     p = in.vec2();

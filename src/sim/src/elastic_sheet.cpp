@@ -1345,13 +1345,30 @@ void ElasticSheet::saveState(StateWriter& out) const {
   out.f64s(s.hingeRest);
   out.f64s(s.hingeFactor);
   out.f64s(s.hingeBranch);
-  out.count(s.lastContacts.size());
-  for (const auto& c : s.lastContacts) {
+  saveContactSamples(out, s.lastContacts);
+}
+
+void saveContactSamples(StateWriter& out, const std::vector<ContactSample>& samples) {
+  out.count(samples.size());
+  for (const auto& c : samples) {
     out.i32(c.vertex);
     out.i32(c.collider);
     out.f64(c.slideSpeed);
     out.f64(c.normalForce);
   }
+}
+
+std::vector<ContactSample> restoreContactSamples(StateReader& in, std::size_t vertexCount) {
+  std::vector<ContactSample> samples(in.count(24));
+  for (auto& c : samples) {
+    c.vertex = in.i32();
+    c.collider = in.i32();
+    c.slideSpeed = in.f64();
+    c.normalForce = in.f64();
+    if (c.vertex < 0 || static_cast<std::size_t>(c.vertex) >= vertexCount)
+      in.fail("a contact's vertex is out of range");
+  }
+  return samples;
 }
 
 void ElasticSheet::restoreState(StateReader& in) {
@@ -1366,15 +1383,7 @@ void ElasticSheet::restoreState(StateReader& in) {
       branch.size() != s.hinges.size())
     in.fail("the elastic state's hinges do not match the sheet's " +
             std::to_string(s.hinges.size()));
-  std::vector<ContactSample> contacts(in.count(24));
-  for (auto& c : contacts) {
-    c.vertex = in.i32();
-    c.collider = in.i32();
-    c.slideSpeed = in.f64();
-    c.normalForce = in.f64();
-    if (c.vertex < 0 || static_cast<std::size_t>(c.vertex) >= s.vertexCount)
-      in.fail("a contact's vertex is out of range");
-  }
+  std::vector<ContactSample> contacts = restoreContactSamples(in, s.vertexCount);
   s.x = std::move(x);
   s.v = std::move(v);
   s.hingeRest = std::move(rest);

@@ -94,6 +94,12 @@ struct ContactSample {
   double normalForce = 0.0;  // N, the contact's penalty force
 };
 
+// Checkpoint and resume (issue 8): a list of contact samples in a state.
+// restoreContactSamples throws CorruptDataError for a vertex outside
+// [0, vertexCount).
+void saveContactSamples(StateWriter& out, const std::vector<ContactSample>& samples);
+std::vector<ContactSample> restoreContactSamples(StateReader& in, std::size_t vertexCount);
+
 // The contact failsafe on its own, for a caller that moves vertices after
 // the elastic step (the crumpling model's isometry projection): free
 // vertices (held[v] == 0) nearer than (1 - kContactFailsafeSlack) distance
