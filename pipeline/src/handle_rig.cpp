@@ -140,21 +140,69 @@ HandleRig::HandleRig(const io::SceneSpec& scene, const io::AnimationScene* anima
       for (int n : h.tangentVertices) usedVertices.emplace(n, h.name);
     }
     handles_.push_back(std::move(h));
+    bindTargets_.push_back(pose.position);
+    bindPattern_.push_back(spec.patternPoint.value_or(sheet.pattern[vertex]));
   }
+  reachLimit_ = scene.sheet.kind == io::SheetSpec::Kind::Rectangle && !scene.tear.enabled;
 }
 
 Vec3 HandleRig::target(std::size_t handle, double t) const {
   return animation_->worldPose(handles_[handle].node, t).position;
 }
 
+std::vector<Vec3> HandleRig::heldTargets(double t, std::vector<char>& held) const {
+  const std::size_t n = handles_.size();
+  std::vector<Vec3> nodes(n), out(n);
+  held.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& h = handles_[i];
+    held[i] = h.releases && t >= h.releaseTime ? 0 : 1;
+    nodes[i] = out[i] = target(i, t);
+  }
+  if (!reachLimit_) return out;
+  // A convex pattern's geodesics are straight: two held points of an
+  // untearable sheet stay within their pattern distance. Violated pairs are
+  // resolved in sweeps (Gauss-Seidel), the handle whose node has moved
+  // farther from its first-frame position yielding onto the other's sphere.
+  constexpr int kSweeps = 16;
+  for (int sweep = 0; sweep < kSweeps; ++sweep) {
+    bool moved = false;
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t j = i + 1; j < n; ++j) {
+        if (!held[i] || !held[j]) continue;
+        const double reach = (1.0 + kReachSlack) * (bindPattern_[i] - bindPattern_[j]).norm();
+        const double d = (out[j] - out[i]).norm();
+        if (d <= reach) continue;
+        const bool iYields =
+            (nodes[i] - bindTargets_[i]).norm() > (nodes[j] - bindTargets_[j]).norm();
+        const std::size_t y = iYields ? i : j, o = iYields ? j : i;
+        out[y] = out[o] + (out[y] - out[o]) * (reach / d);
+        moved = true;
+      }
+    if (!moved) break;
+  }
+  return out;
+}
+
+double HandleRig::reachExcess(std::size_t handle, double t) const {
+  if (!reachLimit_) return 0.0;
+  std::vector<char> held;
+  const std::vector<Vec3> targets = heldTargets(t, held);
+  return held[handle] ? (targets[handle] - target(handle, t)).norm() : 0.0;
+}
+
 void HandleRig::pins(double t, std::vector<sim::Pin>& out) const {
   out.clear();
-  for (const auto& h : handles_) {
-    if (h.releases && t >= h.releaseTime) continue;
-    const Pose pose = animation_->worldPose(h.node, t);
-    out.push_back({h.vertex, pose.position});
+  std::vector<char> held;
+  const std::vector<Vec3> targets = heldTargets(t, held);
+  for (std::size_t i = 0; i < handles_.size(); ++i) {
+    if (!held[i]) continue;
+    const auto& h = handles_[i];
+    const Quat rotation =
+        h.tangentVertices.empty() ? Quat::Identity() : animation_->worldPose(h.node, t).rotation;
+    out.push_back({h.vertex, targets[i]});
     for (std::size_t k = 0; k < h.tangentVertices.size(); ++k)
-      out.push_back({h.tangentVertices[k], pose.position + pose.rotation * h.tangentOffsets[k]});
+      out.push_back({h.tangentVertices[k], targets[i] + rotation * h.tangentOffsets[k]});
   }
 }
 

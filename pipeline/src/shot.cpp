@@ -16,6 +16,7 @@
 #include <numbers>
 #include <optional>
 #include <string_view>
+#include <tuple>
 
 #include "checkpoint.hpp"
 #include "crumple/core/error.hpp"
@@ -437,6 +438,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   params.massDamping = scene.sim.massDamping;
   params.stiffnessDamping = scene.sim.stiffnessDamping;
   params.maxNewtonIterations = scene.sim.maxNewtonIterations;
+  params.recoverFailedSteps = true;  // issue 9: before a shot stops on a failed step
   const std::uint64_t seed = options.seed.value_or(scene.seed);
   std::unique_ptr<paper::HybridSheet> hybrid;
   mesh::SheetMesh sheet;
@@ -561,6 +563,40 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   // tear advances (thesis 3.3.4).
   std::optional<cache::ExtensionBlock> tearAtlasBlock;
   mesh::SheetMesh bakedSheet;  // the triangles and pattern tearAtlasBlock refers to
+  // Per handle pulled beyond the sheet's reach: first and last frame, most (m).
+  std::map<std::size_t, std::tuple<int, int, double>> beyondReach;
+  // Frames whose elastic step needed more Newton iterations, or went on
+  // without self-contact, after failing at every halving (first, last).
+  std::pair<int, int> newtonRetried{-1, -1}, selfContactDropped{-1, -1};
+  const auto noteRecovery = [&](const sim::StepStats& stats, int frame) {
+    for (auto [happened, span] : {std::pair{stats.newtonRetried, &newtonRetried},
+                                  std::pair{stats.selfContactDropped, &selfContactDropped}})
+      if (happened > 0) {
+        if (span->first < 0) span->first = frame;
+        span->second = frame;
+      }
+  };
+  const auto stabilityWarnings = [&] {
+    if (newtonRetried.first >= 0)
+      report.warnings.push_back(
+          "the elastic solve needed " + std::to_string(sim::kRetryIterationFactor) +
+          " times [sim] max_newton_iterations at frames " + std::to_string(newtonRetried.first) +
+          "-" + std::to_string(newtonRetried.second));
+    if (selfContactDropped.first >= 0)
+      report.warnings.push_back(
+          "the elastic solve failed with self-contact and went on without it at frames " +
+          std::to_string(selfContactDropped.first) + "-" +
+          std::to_string(selfContactDropped.second) + ": the sheet may pass through itself there");
+    for (const auto& [h, span] : beyondReach) {
+      char text[320];
+      std::snprintf(text, sizeof text,
+                    "handle '%s' is pulled beyond the sheet's reach at frames %d-%d (up to %.3g m "
+                    "past it): it stops on the reach and lags behind its node there",
+                    rig.handles()[h].name.c_str(), std::get<0>(span), std::get<1>(span),
+                    std::get<2>(span));
+      report.warnings.push_back(text);
+    }
+  };
   auto emit = [&](int frame) {
     const double t = frameTime(scene, frame);
     record.frame = frame;
@@ -610,6 +646,13 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
       const bool held = !(bound.releases && t >= bound.releaseTime);
       record.handleVertices.push_back(held ? bound.vertex : -1);
       record.handleTargets.push_back(rig.target(h, t));
+      // A node beyond the sheet's reach (issue 9): the handle lags behind it.
+      if (const double excess = rig.reachExcess(h, t); excess > 0.0) {
+        auto& [first, last, most] = beyondReach.try_emplace(h, -1, -1, 0.0).first->second;
+        if (first < 0) first = frame;
+        last = frame;
+        most = std::max(most, excess);
+      }
     }
     record.camera = cameraAt(scene, animation.get(), t);
     record.extensions.clear();
@@ -996,6 +1039,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
         const auto stats = hybrid->advance(t, 1.0 / scene.fps, scene.substeps, pins, frame);
         report.newtonIterations += stats.elastic.newtonIterations;
         report.halvings += stats.elastic.halvings;
+        noteRecovery(stats.elastic, frame);
         report.elasticRetries += stats.elasticRetries;
         report.substeps += scene.substeps;
         report.contactMs += stats.elastic.contactMs + stats.ms.contacts;
@@ -1032,6 +1076,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
           report.contactMs += stats.contactMs;
           report.selfContactMs += stats.selfContactMs;
           report.selfContactSteps += stats.selfContactSteps;
+          noteRecovery(stats, frame);
           ++report.substeps;
         } catch (const NumericalError& e) {
           throw NumericalError(e.stage(), frame, e.problem());
@@ -1051,6 +1096,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     report.hybrid = hybridModel;
     if (report.framesSimulated > 0) report.meanCMean /= report.framesSimulated;
     writer->close();  // the cache stays valid up to the last good frame
+    stabilityWarnings();
     writeSummary(scene, report, options);
     throw;
   }
@@ -1086,6 +1132,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
         100.0 * report.maxCMean, report.maxCMeanFrame);
     report.warnings.push_back(text);
   }
+  stabilityWarnings();
   if (report.halvings > 0)
     report.warnings.push_back("the elastic solve halved its substep " +
                               std::to_string(report.halvings) +

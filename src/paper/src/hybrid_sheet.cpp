@@ -41,6 +41,8 @@ void accumulate(HybridStepStats& total, const HybridStepStats& s) {
   total.elastic.halvings += s.elastic.halvings;
   total.elastic.solves += s.elastic.solves;
   total.elastic.finalStepNorm = s.elastic.finalStepNorm;
+  total.elastic.newtonRetried += s.elastic.newtonRetried;
+  total.elastic.selfContactDropped += s.elastic.selfContactDropped;
   total.elasticRetries += s.elasticRetries;
   GeometricStepStats& g = total.geometric;
   const GeometricStepStats& h = s.geometric;

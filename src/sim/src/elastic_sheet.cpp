@@ -1271,6 +1271,58 @@ StepStats ElasticSheet::advance(double t, double dt, const PinFunction& pins) {
     impl_->v = v0;
     throw;
   }
+  // Recovery (issue 9, stability), only for a step that failed at every
+  // halving (a path the samples never take). If self-contact ran, the step
+  // is taken again without it: its penalty can keep a handle jumping through
+  // the sheet or a tight twist from converging. Then, as the projected Newton
+  // iteration converges only linearly near tight folds, with
+  // kRetryIterationFactor times the iterations (and up to 3 halvings), with
+  // self-contact and, if it ran, without. Only then does the shot stop.
+  const auto retry = [&](int maxIterations, SelfContactMode self, int depth, const char* what) {
+    impl_->x = x0;
+    impl_->v = v0;
+    const int savedIterations = impl_->params.maxNewtonIterations;
+    const SelfContactMode savedSelf = impl_->contact.self;
+    impl_->params.maxNewtonIterations = maxIterations;
+    impl_->contact.self = self;
+    StepStats more;
+    std::string moreWhy;
+    bool done = false;
+    try {
+      done = impl_->stepRecursive(t, t + dt, pins, depth, more, moreWhy);
+    } catch (...) {
+      impl_->params.maxNewtonIterations = savedIterations;
+      impl_->contact.self = savedSelf;
+      impl_->x = x0;
+      impl_->v = v0;
+      throw;
+    }
+    impl_->params.maxNewtonIterations = savedIterations;
+    impl_->contact.self = savedSelf;
+    stats.newtonIterations += more.newtonIterations;
+    stats.halvings += more.halvings;
+    stats.solves += more.solves;
+    stats.finalStepNorm = more.finalStepNorm;
+    stats.contactMs += more.contactMs;
+    stats.selfContactMs += more.selfContactMs;
+    if (!done) why += std::string("; ") + what + ": " + moreWhy;
+    return done;
+  };
+  const SimParams& p = impl_->params;
+  const bool selfRan = impl_->contact.self != SelfContactMode::Off && stats.selfContactSteps > 0;
+  if (!ok && selfRan && p.recoverFailedSteps) {
+    ok = retry(p.maxNewtonIterations, SelfContactMode::Off, 0, "without self-contact");
+    if (ok) stats.selfContactDropped = 1;
+  }
+  const SelfContactMode modes[] = {impl_->contact.self, SelfContactMode::Off};
+  for (int k = 0; k < (selfRan ? 2 : 1) && !ok && p.recoverFailedSteps; ++k) {
+    ok = retry(kRetryIterationFactor * p.maxNewtonIterations, modes[k],
+               std::max(0, p.maxHalvings - 3),
+               k == 1 ? "with more Newton iterations, without self-contact"
+                      : "with more Newton iterations");
+    if (ok) stats.newtonRetried = 1;
+    if (ok && k == 1) stats.selfContactDropped = 1;
+  }
   if (!ok) {
     impl_->x = x0;
     impl_->v = v0;

@@ -46,8 +46,17 @@ class HandleRig {
   const std::vector<std::string>& bindWarnings() const { return warnings_; }
   // Position of the handle's node at time t (world, metres).
   Vec3 target(std::size_t handle, double t) const;
-  // Every pinned vertex and where it must be at time t.
+  // Every pinned vertex and where it must be at time t: on its node, unless
+  // the nodes pull the sheet beyond its reach (reachExcess).
   void pins(double t, std::vector<sim::Pin>& out) const;
+  // The sheet's reach (issue 9, stability): a rectangular sheet that cannot
+  // tear cannot hold two handles farther apart than their pattern points
+  // (times 1 + kReachSlack). Where the nodes ask for more, the handle whose
+  // node has moved farther from its first-frame position stops on that
+  // reach and lags behind its node; this is how far (m), 0 within reach.
+  // Off (always 0) for outlines, pattern meshes and sheets that tear.
+  double reachExcess(std::size_t handle, double t) const;
+  static constexpr double kReachSlack = 1e-3;
   // The hybrid model rebuilds its simulation mesh S_P as the sheet crumples:
   // handle vertices keep their indices, tangent-plane vertices are chosen
   // again on the new mesh at time t, their offsets measured from where they
@@ -67,8 +76,15 @@ class HandleRig {
   void restoreState(StateReader& in);
 
  private:
+  // The held handles' positions at time t, limited to the sheet's reach;
+  // `held` says which handles hold at t.
+  std::vector<Vec3> heldTargets(double t, std::vector<char>& held) const;
+
   const io::AnimationScene* animation_;
   std::vector<BoundHandle> handles_;
+  bool reachLimit_ = false;
+  std::vector<Vec3> bindTargets_;  // each node's position at the first frame
+  std::vector<Vec2> bindPattern_;  // each handle's pattern point (else its vertex's)
   std::vector<std::string> warnings_;
 };
 

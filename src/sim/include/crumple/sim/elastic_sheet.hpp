@@ -38,6 +38,11 @@ struct SimParams {
   // sliver triangles whose vertices would weigh ~1e-4 of the others and stall
   // Newton's convergence; the floor adds a negligible mass there.
   double minVertexMassFraction = 0.0;
+  // Recovery of a step that failed at every halving (issue 9, stability;
+  // ElasticSheet::advance): taken again without self-contact, then with
+  // kRetryIterationFactor times maxNewtonIterations. Off by default; a shot
+  // (pipeline::runShot) turns it on.
+  bool recoverFailedSteps = false;
 };
 
 // A hard constraint: vertex `vertex` sits at `position`.
@@ -57,7 +62,13 @@ struct StepStats {
   double contactMs = 0.0;      // collider detection and failsafe, wall time (timing only)
   double selfContactMs = 0.0;  // self-contact gate, detection and failsafe (timing only)
   int selfContactSteps = 0;    // (sub)steps in which self-contact detection ran
+  // Recovery of a step that failed even after halving (issue 9, stability):
+  // taken again with kRetryIterationFactor times the Newton iterations, or
+  // else without self-contact (the sheet may pass through itself there).
+  int newtonRetried = 0;
+  int selfContactDropped = 0;
 };
+inline constexpr int kRetryIterationFactor = 10;
 
 // The contact failsafe projection acts on vertices the penalty left more
 // than this fraction of the contact distance too near (a penalty equilibrium
