@@ -459,6 +459,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     hybrid->setTime(t0);
     hybrid->setRebuildCallback(
         [&rig](const mesh::SheetMesh& sp, double t) { rig.rebindTangents(sp, t); });
+    if (options.projectionProbe) hybrid->setProjectionCallback(options.projectionProbe);
   }
   for (int f = scene.frameStart; f <= range.last; ++f)
     (void)cameraAt(scene, animation.get(), frameTime(scene, f));

@@ -87,6 +87,15 @@ struct HybridSheet::Impl {
   std::vector<Vec3> spVelocities;
   double paperLength = 0.0;
   std::function<void(const mesh::SheetMesh&, double)> onRebuild;
+  std::function<void(const ProjectionInput&)> onProjection;  // paper Table III inputs
+  // The isometry projection's options from the parameters (paper Sec. 6.3).
+  IsometryOptions isometryOptions() const {
+    IsometryOptions iso;
+    iso.rounds = params.isometryRounds;
+    iso.lengthSweeps = params.isometryLengthSweeps;
+    iso.lengthTolerance = params.isometryLengthTolerance;
+    return iso;
+  }
   double time = 0.0;            // time S_G and S_P are at
   sim::ContactOptions contact;  // issue 5
   std::vector<sim::ContactSample> contacts;
@@ -238,6 +247,10 @@ void HybridSheet::setRebuildCallback(
     std::function<void(const mesh::SheetMesh&, double t)> callback) {
   impl_->onRebuild = std::move(callback);
   if (impl_->onRebuild) impl_->onRebuild(impl_->sp.mesh, impl_->time);
+}
+
+void HybridSheet::setProjectionCallback(std::function<void(const ProjectionInput&)> callback) {
+  impl_->onProjection = std::move(callback);
 }
 
 void HybridSheet::placeVertices(const std::vector<sim::Pin>& pins) {
@@ -604,11 +617,11 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
   if (!m.isometry || !m.isometry->sameTopology(m.sp.mesh.triangles, fixed) ||
       static_cast<std::size_t>(m.isometry->vertexCount()) != m.sp.mesh.vertexCount() ||
       stats.topologyChanged) {
-    IsometryOptions iso;
-    iso.rounds = m.params.isometryRounds;
-    iso.lengthSweeps = m.params.isometryLengthSweeps;
-    iso.lengthTolerance = m.params.isometryLengthTolerance;
-    m.isometry.emplace(m.sp.mesh.pattern, m.sp.mesh.triangles, fixed, iso);
+    m.isometry.emplace(m.sp.mesh.pattern, m.sp.mesh.triangles, fixed, m.isometryOptions());
+  }
+  if (m.onProjection) {
+    m.onProjection({m.sp.mesh.pattern, m.sp.mesh.triangles, fixed, m.sp.mesh.positions,
+                    m.isometryOptions(), m.params.isometryIterations, frame, t + dt});
   }
   std::vector<Vec3> positions = m.sp.mesh.positions;
   stats.isometry = m.isometry->project(positions, m.params.isometryIterations);

@@ -2,17 +2,15 @@
 // scheme and for every deviation from the paper.
 #include "crumple/paper/isometry.hpp"
 
-#include <Eigen/SparseCholesky>
-#include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
-#include <limits>
-#include <numeric>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
 
 #include "crumple/core/error.hpp"
+#include "pattern_edges.hpp"
 
 namespace crumple::paper {
 
@@ -20,30 +18,20 @@ namespace {
 
 constexpr const char* kStage = "isometry";
 
-bool finite(const Vec3& v) { return v.allFinite(); }
-
 }  // namespace
 
 struct IsometryProjector::Impl {
-  int n = 0;
   std::vector<Vec2> pattern;
   std::vector<std::array<int, 3>> triangles;
-  std::vector<int> fixed;                       // sorted, unique
-  std::vector<std::array<int, 2>> edges;        // (i, j), i < j, sorted
-  std::vector<double> restLength;               // lbar_e (m)
-  double lengthScale = 1.0;                     // mean lbar_e: Phase I works in lbar / lengthScale
-  std::vector<std::array<int, 3>> triEdges;     // edges ab, bc, ca of each triangle
-  std::vector<std::array<double, 3>> triSigns;  // +1 when the triangle walks the edge i -> j
-
+  // Edges (i < j, sorted), lbar_e, triangle-edge incidence and signs (eq. (3)).
+  std::optional<detail::PatternEdges> graph;
+  double lengthScale = 1.0;  // mean lbar_e: Phase I works in lbar / lengthScale
   // Phase II (eq. (7)): graph Laplacian restricted to the free vertices.
-  std::vector<int> freeIndex;  // -1 for a pinned vertex (fixed or component anchor)
-  std::vector<std::vector<int>> floatingComponents;  // components without a fixed vertex
-  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> factor;
-  int freeCount = 0;
+  std::optional<detail::EdgeFitSolver> phaseTwoSolver;
 
   IsometryOptions options;
 
-  void build();
+  void build(std::vector<int> fixedVertices);
   int phaseOne(const std::vector<Vec3>& u0, std::vector<Vec3>& u, int maxIterations) const;
   std::vector<Vec3> phaseTwo(const std::vector<Vec3>& input, const std::vector<Vec3>& u) const;
   int polishLengths(std::vector<Vec3>& p) const;
@@ -62,8 +50,10 @@ int IsometryProjector::Impl::polishLengths(std::vector<Vec3>& p) const {
     bool freeI, freeJ;
     double rest, weightSum;  // pattern length; inverse masses summed (1 or 2)
   };
-  std::vector<char> isFixed(static_cast<std::size_t>(n), 0);
-  for (int v : fixed) isFixed[static_cast<std::size_t>(v)] = 1;
+  const auto& edges = graph->edges;
+  const auto& restLength = graph->restLength;
+  std::vector<char> isFixed(static_cast<std::size_t>(graph->n), 0);
+  for (int v : graph->fixed) isFixed[static_cast<std::size_t>(v)] = 1;
   std::vector<Rod> rods;
   rods.reserve(edges.size());
   for (std::size_t e = 0; e < edges.size(); ++e) {
@@ -95,121 +85,18 @@ int IsometryProjector::Impl::polishLengths(std::vector<Vec3>& p) const {
 
 // Edge list, triangle-edge incidence with orientation signs (eq. (3)), and
 // the Phase II matrix of eq. (7), factored once per topology.
-void IsometryProjector::Impl::build() {
-  n = static_cast<int>(pattern.size());
-  for (const Vec2& p : pattern) {
-    if (!p.allFinite()) throw std::invalid_argument("isometry: non-finite pattern coordinate");
-  }
-  for (const auto& t : triangles) {
-    for (int k = 0; k < 3; ++k) {
-      if (t[k] < 0 || t[k] >= n) throw std::invalid_argument("isometry: vertex index out of range");
-    }
-    if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) {
-      throw std::invalid_argument("isometry: triangle with a repeated vertex");
-    }
-  }
+void IsometryProjector::Impl::build(std::vector<int> fixedVertices) {
   if (options.rounds < 1) throw std::invalid_argument("isometry: rounds must be >= 1");
   if (!(options.tolerance > 0.0)) throw std::invalid_argument("isometry: tolerance must be > 0");
   if (options.lengthSweeps < 0) throw std::invalid_argument("isometry: negative lengthSweeps");
   if (!(options.lengthTolerance >= 0.0))
     throw std::invalid_argument("isometry: lengthTolerance must be >= 0");
-  std::sort(fixed.begin(), fixed.end());
-  fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
-  for (int v : fixed) {
-    if (v < 0 || v >= n) throw std::invalid_argument("isometry: fixed vertex out of range");
-  }
-
-  // Undirected edges, each oriented from the lower to the higher index.
-  std::vector<std::array<int, 2>> all;
-  all.reserve(3 * triangles.size());
-  for (const auto& t : triangles) {
-    for (int k = 0; k < 3; ++k) {
-      const int a = t[k], b = t[(k + 1) % 3];
-      all.push_back({std::min(a, b), std::max(a, b)});
-    }
-  }
-  std::sort(all.begin(), all.end());
-  all.erase(std::unique(all.begin(), all.end()), all.end());
-  edges = std::move(all);
-  auto edgeIndex = [&](int a, int b) {
-    const std::array<int, 2> key{std::min(a, b), std::max(a, b)};
-    return static_cast<int>(std::lower_bound(edges.begin(), edges.end(), key) - edges.begin());
-  };
-  restLength.resize(edges.size());
+  graph.emplace(pattern, triangles, std::move(fixedVertices), kStage);
   double sum = 0.0;
-  for (std::size_t e = 0; e < edges.size(); ++e) {
-    restLength[e] = (pattern[edges[e][1]] - pattern[edges[e][0]]).norm();
-    if (!(restLength[e] > 0.0)) {
-      throw std::invalid_argument("isometry: zero-length pattern edge (" +
-                                  std::to_string(edges[e][0]) + ", " + std::to_string(edges[e][1]) +
-                                  ")");
-    }
-    sum += restLength[e];
-  }
-  lengthScale = edges.empty() ? 1.0 : sum / static_cast<double>(edges.size());
-  triEdges.resize(triangles.size());
-  triSigns.resize(triangles.size());
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
-    for (int k = 0; k < 3; ++k) {
-      const int a = triangles[t][k], b = triangles[t][(k + 1) % 3];
-      triEdges[t][k] = edgeIndex(a, b);
-      triSigns[t][k] = a < b ? 1.0 : -1.0;
-    }
-  }
-
-  // Connected components (union-find, deterministic: the root is the lowest index).
-  std::vector<int> parent(n);
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](int v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  for (const auto& e : edges) {
-    const int ra = find(e[0]), rb = find(e[1]);
-    if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
-  }
-  std::vector<char> anchored(n, 0);
-  for (int v : fixed) anchored[find(v)] = 1;
-  freeIndex.assign(n, 0);
-  for (int v : fixed) freeIndex[v] = -1;
-  std::vector<int> componentSlot(n, -1);
-  for (int v = 0; v < n; ++v) {
-    const int r = find(v);
-    if (anchored[r]) continue;
-    if (r == v) {
-      // The lowest vertex of a component without a fixed vertex is pinned;
-      // Phase II then translates the component back to its input centroid.
-      freeIndex[v] = -1;
-      componentSlot[v] = static_cast<int>(floatingComponents.size());
-      floatingComponents.emplace_back();
-    }
-    floatingComponents[componentSlot[r]].push_back(v);
-  }
-  freeCount = 0;
-  for (int v = 0; v < n; ++v) {
-    if (freeIndex[v] >= 0) freeIndex[v] = freeCount++;
-  }
-
+  for (const double l : graph->restLength) sum += l;
+  lengthScale = graph->edges.empty() ? 1.0 : sum / static_cast<double>(graph->edges.size());
   // Eq. (7): normal equations are the graph Laplacian on the free vertices.
-  std::vector<Eigen::Triplet<double>> trip;
-  trip.reserve(4 * edges.size());
-  for (const auto& e : edges) {
-    const int fa = freeIndex[e[0]], fb = freeIndex[e[1]];
-    if (fa >= 0) trip.emplace_back(fa, fa, 1.0);
-    if (fb >= 0) trip.emplace_back(fb, fb, 1.0);
-    if (fa >= 0 && fb >= 0) {
-      trip.emplace_back(fa, fb, -1.0);
-      trip.emplace_back(fb, fa, -1.0);
-    }
-  }
-  Eigen::SparseMatrix<double> laplacian(freeCount, freeCount);
-  laplacian.setFromTriplets(trip.begin(), trip.end());
-  if (freeCount > 0) {
-    factor.compute(laplacian);
-    if (factor.info() != Eigen::Success) {
-      throw NumericalError(kStage, "Phase II Laplacian factorisation failed");
-    }
-  }
+  phaseTwoSolver.emplace(*graph, std::vector<double>{}, kStage, "Phase II");
 }
 
 // Paper Sec. 6.3, Phase I, eqs. (3)-(6): iterates the unit edge directions u
@@ -217,7 +104,10 @@ void IsometryProjector::Impl::build() {
 // Lagrange multipliers and H = I. Returns the number of iterations taken.
 int IsometryProjector::Impl::phaseOne(const std::vector<Vec3>& u0, std::vector<Vec3>& u,
                                       int maxIterations) const {
-  const std::size_t m = edges.size(), nt = triangles.size();
+  const auto& restLength = graph->restLength;
+  const auto& triEdges = graph->triEdges;
+  const auto& triSigns = graph->triSigns;
+  const std::size_t m = graph->edges.size(), nt = triangles.size();
   if (m == 0 || nt == 0) return 0;
   const bool anchored = options.objective == PhaseOneObjective::Anchored;
   const double tol = options.tolerance;
@@ -329,41 +219,12 @@ int IsometryProjector::Impl::phaseOne(const std::vector<Vec3>& u0, std::vector<V
 
 // Paper Sec. 6.3, Phase II, eq. (7): min 1/2 sum_e |(p_j - p_i) - lbar_e u_e|^2
 // over the free vertices; fixed and anchor vertices keep their `input`
-// positions and move to the right-hand side. x, y, z share the factor.
+// positions (detail::EdgeFitSolver).
 std::vector<Vec3> IsometryProjector::Impl::phaseTwo(const std::vector<Vec3>& input,
                                                     const std::vector<Vec3>& u) const {
-  std::vector<Vec3> out = input;
-  if (freeCount > 0) {
-    Eigen::MatrixX3d rhs = Eigen::MatrixX3d::Zero(freeCount, 3);
-    for (std::size_t e = 0; e < edges.size(); ++e) {
-      const int i = edges[e][0], j = edges[e][1];
-      const Vec3 w = restLength[e] * u[e];
-      const int fi = freeIndex[i], fj = freeIndex[j];
-      if (fj >= 0) rhs.row(fj) += w.transpose();
-      if (fi >= 0) rhs.row(fi) -= w.transpose();
-      if (fi >= 0 && fj < 0) rhs.row(fi) += input[j].transpose();
-      if (fj >= 0 && fi < 0) rhs.row(fj) += input[i].transpose();
-    }
-    Eigen::MatrixX3d x(freeCount, 3);
-    for (int c = 0; c < 3; ++c) x.col(c) = factor.solve(rhs.col(c));
-    if (factor.info() != Eigen::Success) throw NumericalError(kStage, "Phase II solve failed");
-    for (int v = 0; v < n; ++v) {
-      if (freeIndex[v] >= 0) out[v] = x.row(freeIndex[v]).transpose();
-    }
-  }
-  for (const auto& comp : floatingComponents) {
-    Vec3 shift = Vec3::Zero();
-    for (int v : comp) shift += input[v] - out[v];
-    shift /= static_cast<double>(comp.size());
-    for (int v : comp) out[v] += shift;
-  }
-  for (int v = 0; v < n; ++v) {
-    if (!finite(out[v])) {
-      throw NumericalError(
-          kStage, "Phase II produced a non-finite position at vertex " + std::to_string(v));
-    }
-  }
-  return out;
+  std::vector<Vec3> target(u.size());
+  for (std::size_t e = 0; e < u.size(); ++e) target[e] = graph->restLength[e] * u[e];
+  return phaseTwoSolver->solve(input, target);
 }
 
 IsometryProjector::IsometryProjector(std::vector<Vec2> pattern,
@@ -372,17 +233,16 @@ IsometryProjector::IsometryProjector(std::vector<Vec2> pattern,
     : impl_(std::make_unique<Impl>()) {
   impl_->pattern = std::move(pattern);
   impl_->triangles = std::move(triangles);
-  impl_->fixed = std::move(fixedVertices);
   impl_->options = options;
-  impl_->build();
+  impl_->build(std::move(fixedVertices));
 }
 
 IsometryProjector::~IsometryProjector() = default;
 IsometryProjector::IsometryProjector(IsometryProjector&&) noexcept = default;
 IsometryProjector& IsometryProjector::operator=(IsometryProjector&&) noexcept = default;
 
-int IsometryProjector::vertexCount() const { return impl_->n; }
-int IsometryProjector::edgeCount() const { return static_cast<int>(impl_->edges.size()); }
+int IsometryProjector::vertexCount() const { return impl_->graph->n; }
+int IsometryProjector::edgeCount() const { return static_cast<int>(impl_->graph->edges.size()); }
 
 bool IsometryProjector::sameTopology(const std::vector<std::array<int, 3>>& triangles,
                                      const std::vector<int>& fixedVertices) const {
@@ -390,48 +250,30 @@ bool IsometryProjector::sameTopology(const std::vector<std::array<int, 3>>& tria
   std::vector<int> f = fixedVertices;
   std::sort(f.begin(), f.end());
   f.erase(std::unique(f.begin(), f.end()), f.end());
-  return f == impl_->fixed;
+  return f == impl_->graph->fixed;
 }
 
 // Paper Sec. 6.3: Phase I (eqs. (3)-(6)) then Phase II (eq. (7)), `rounds` times.
 IsometryStats IsometryProjector::project(std::vector<Vec3>& positions, int maxIterations) const {
   const Impl& im = *impl_;
+  const detail::PatternEdges& g = *im.graph;
   if (maxIterations < 0) throw std::invalid_argument("isometry: negative iteration cap");
-  if (static_cast<int>(positions.size()) != im.n) {
-    throw NumericalError(kStage, "expected " + std::to_string(im.n) + " positions, got " +
-                                     std::to_string(positions.size()));
-  }
-  for (int v = 0; v < im.n; ++v) {
-    if (!finite(positions[v])) {
-      throw NumericalError(kStage, "non-finite input position at vertex " + std::to_string(v));
-    }
-  }
-  const std::size_t m = im.edges.size();
-  auto lengthErrors = [&](const std::vector<Vec3>& p, double& mean, double& max) {
-    mean = 0.0;
-    max = 0.0;
-    for (std::size_t e = 0; e < m; ++e) {
-      const double l = (p[im.edges[e][1]] - p[im.edges[e][0]]).norm();
-      const double err = std::abs(l - im.restLength[e]) / im.restLength[e];
-      mean += err;
-      max = std::max(max, err);
-    }
-    if (m > 0) mean /= static_cast<double>(m);
-  };
+  g.checkPositions(positions, kStage);
+  const std::size_t m = g.edges.size();
   IsometryStats stats;
   double dummy = 0.0;
-  lengthErrors(positions, stats.meanLengthErrorBefore, dummy);
+  g.lengthErrors(positions, stats.meanLengthErrorBefore, dummy);
 
   std::vector<Vec3> current = positions;
   std::vector<Vec3> u0(m), u(m);
   for (int round = 0; round < im.options.rounds; ++round) {
     // u0: the current normalised edge directions (the start of Phase I).
     for (std::size_t e = 0; e < m; ++e) {
-      const Vec3 d = current[im.edges[e][1]] - current[im.edges[e][0]];
+      const Vec3 d = current[g.edges[e][1]] - current[g.edges[e][0]];
       const double len = d.norm();
-      if (!(len > 1e-14 * im.restLength[e])) {
-        throw NumericalError(kStage, "edge (" + std::to_string(im.edges[e][0]) + ", " +
-                                         std::to_string(im.edges[e][1]) +
+      if (!(len > 1e-14 * g.restLength[e])) {
+        throw NumericalError(kStage, "edge (" + std::to_string(g.edges[e][0]) + ", " +
+                                         std::to_string(g.edges[e][1]) +
                                          ") has collapsed to zero length");
       }
       u0[e] = d / len;
@@ -448,13 +290,11 @@ IsometryStats IsometryProjector::project(std::vector<Vec3>& positions, int maxIt
   }
   stats.lengthSweeps = im.polishLengths(current);
   for (const Vec3& x : current) {
-    if (!finite(x)) throw NumericalError(kStage, "non-finite position after the length sweeps");
+    if (!x.allFinite()) throw NumericalError(kStage, "non-finite position after the length sweeps");
   }
 
-  lengthErrors(current, stats.meanLengthErrorAfter, stats.maxLengthErrorAfter);
-  double disp = 0.0;
-  for (int v = 0; v < im.n; ++v) disp += (current[v] - positions[v]).norm();
-  stats.meanDisplacement = im.n > 0 ? disp / im.n : 0.0;
+  g.lengthErrors(current, stats.meanLengthErrorAfter, stats.maxLengthErrorAfter);
+  stats.meanDisplacement = detail::meanDisplacement(current, positions);
   positions = std::move(current);
   return stats;
 }

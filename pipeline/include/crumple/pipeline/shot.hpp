@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -16,6 +17,10 @@
 #include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/render/view.hpp"
 #include "crumple/tear/tearing.hpp"
+
+namespace crumple::paper {
+struct ProjectionInput;  // crumple/paper/hybrid_sheet.hpp
+}  // namespace crumple::paper
 
 namespace crumple::pipeline {
 
@@ -56,6 +61,9 @@ struct ShotOptions {
   // run's (docs/CHECKPOINT.md).
   int checkpointEvery = 0;
   bool resume = false;
+  // Crumpling model: called with every isometry projection's input
+  // (paper::HybridSheet::setProjectionCallback; paper Table III, bench).
+  std::function<void(const paper::ProjectionInput&)> projectionProbe;
 };
 
 // Milliseconds spent per stage, summed over the frames it ran for.

@@ -44,6 +44,21 @@ struct HybridStepStats {
   int elasticRetries = 0;        // elastic steps retried with the pins snapped onto their targets
 };
 
+// What the isometry projection (paper Sec. 6.3) is handed in one animation
+// step, just before it runs: S_P's pattern, triangles and positions, the
+// vertices it holds fixed, its options and iteration cap, the frame and
+// the time the step ends at. Valid during the call only.
+struct ProjectionInput {
+  const std::vector<Vec2>& pattern;
+  const std::vector<std::array<int, 3>>& triangles;
+  const std::vector<int>& fixed;
+  const std::vector<Vec3>& positions;
+  IsometryOptions options;
+  int maxIterations = 0;
+  int frame = 0;
+  double t = 0.0;
+};
+
 class HybridSheet {
  public:
   // `sg`: the starting S_G (e.g. makeFlatSheet); its handle vertices are the
@@ -70,6 +85,11 @@ class HybridSheet {
   // rebuilt, before pins are asked for again (the handle rig re-chooses its
   // tangent-plane vertices there).
   void setRebuildCallback(std::function<void(const mesh::SheetMesh&, double t)> callback);
+
+  // Called with every projection's input (paper Table III compares
+  // projections on them, bench/harness/projection_comparison.cpp). Unset by
+  // default (no cost).
+  void setProjectionCallback(std::function<void(const ProjectionInput&)> callback);
 
   // Contacts (issue 5): the elastic step of every animation step takes them
   // (sim::ElasticSheet::setContacts), and after the isometry projection a
