@@ -11,11 +11,15 @@
 #include <algorithm>
 #include <assimp/Importer.hpp>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <set>
 #include <unordered_map>
 
 #include "crumple/core/error.hpp"
+#include "import_probe.hpp"
 
 namespace crumple::io {
 
@@ -412,6 +416,69 @@ struct AnimationScene::Impl {
   }
 };
 
+namespace {
+
+std::uint32_t littleEndian32(const unsigned char* p) {
+  return static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 |
+         static_cast<std::uint32_t>(p[2]) << 16 | static_cast<std::uint32_t>(p[3]) << 24;
+}
+
+// Binary glTF container (glTF 2.0 spec, "GLB File Format Specification"): a
+// 12-byte header (magic "glTF", u32 version, u32 total length) and chunks
+// (u32 length, u32 type, data). assimp 5.2.5 allocates a chunk's declared
+// length before reading it, so a few damaged bytes cost gigabytes and
+// seconds (docs/FUZZING.md); check every length against the file first.
+void checkBinaryGltf(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char header[12] = {};
+  if (!in.read(reinterpret_cast<char*>(header), sizeof header) ||
+      std::memcmp(header, "glTF", 4) != 0) {
+    return;  // not a binary glTF: nothing to check here
+  }
+  std::error_code ec;
+  const std::uintmax_t fileSize = std::filesystem::file_size(path, ec);
+  if (ec) return;
+  const std::uint32_t version = littleEndian32(header + 4);
+  const std::uint64_t length = littleEndian32(header + 8);
+  if (length > fileSize) {
+    throw InputError(path, "binary glTF header gives a length of " + std::to_string(length) +
+                               " bytes, the file has " + std::to_string(fileSize));
+  }
+  // glTF 1.0 (KHR_binary_glTF): u32 content length, u32 content format, content.
+  // glTF 2.0: chunks up to `length`.
+  const std::uint64_t chunkHeader = 8;
+  std::uint64_t offset = 12;
+  for (int chunk = 0; offset + chunkHeader <= length; ++chunk) {
+    unsigned char h[8] = {};
+    in.seekg(static_cast<std::streamoff>(offset));
+    if (!in.read(reinterpret_cast<char*>(h), sizeof h)) break;
+    const std::uint64_t chunkLength = littleEndian32(h);
+    if (chunkLength > length - offset - chunkHeader) {
+      throw InputError(
+          path, "binary glTF " +
+                    std::string(version == 1 ? "content" : "chunk " + std::to_string(chunk)) +
+                    " gives a length of " + std::to_string(chunkLength) + " bytes, only " +
+                    std::to_string(length - offset - chunkHeader) + " follow");
+    }
+    if (version == 1) break;  // one content block, then the binary body
+    offset += chunkHeader + chunkLength;
+  }
+}
+
+// The one assimp import (the probe child and the real import run the same).
+const aiScene* readWithAssimp(Assimp::Importer& importer, const std::string& path) {
+  // Bake FBX pivots into the node transforms instead of "$AssimpFbx$" helper
+  // nodes, so the node the user named is the node that moves.
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
+  // COLLADA: name nodes by their `name` attribute (what DCC outliners show),
+  // not by their `id`.
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_USE_COLLADA_NAMES, true);
+  // No PreTransformVertices / OptimizeGraph: they destroy the animated nodes.
+  return importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+}
+
+}  // namespace
+
 AnimationScene::AnimationScene(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 AnimationScene::AnimationScene(AnimationScene&&) noexcept = default;
 AnimationScene& AnimationScene::operator=(AnimationScene&&) noexcept = default;
@@ -422,16 +489,23 @@ AnimationScene AnimationScene::load(const std::string& path) {
   if (!std::filesystem::exists(path, ec)) throw InputError(path, "no such file");
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path, "not a regular file");
 
+  checkBinaryGltf(path);
+  // A crash or hang inside assimp on this file becomes an InputError here
+  // (import_probe.hpp; docs/FUZZING.md).
+  // A file the importer rejects in the child (out of memory included) is not
+  // imported again here.
+  const std::optional<std::string> rejected = detail::probeInChild(
+      path,
+      [&path] {
+        Assimp::Importer probe;
+        if (readWithAssimp(probe, path)) return std::string();
+        const std::string reason = probe.GetErrorString();
+        return reason.empty() ? std::string("the importer gave no reason") : reason;
+      },
+      detail::importDeadline(), detail::importMemoryLimit());
+  if (rejected && !rejected->empty()) throw InputError(path, "cannot import: " + *rejected);
   Assimp::Importer importer;
-  // Bake FBX pivots into the node transforms instead of "$AssimpFbx$" helper
-  // nodes, so the node the user named is the node that moves.
-  importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
-  // COLLADA: name nodes by their `name` attribute (what DCC outliners show),
-  // not by their `id`.
-  importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_USE_COLLADA_NAMES, true);
-  // No PreTransformVertices / OptimizeGraph: they destroy the animated nodes.
-  const aiScene* scene =
-      importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+  const aiScene* scene = readWithAssimp(importer, path);
   if (!scene) throw InputError(path, std::string("cannot import: ") + importer.GetErrorString());
   if (!scene->mRootNode) throw InputError(path, "cannot import: the file has no node hierarchy");
 
