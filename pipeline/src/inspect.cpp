@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <numbers>
 #include <optional>
 #include <utility>
 
@@ -13,6 +14,42 @@
 #include "json_writer.hpp"
 
 namespace crumple::pipeline {
+
+AngleDefect angleDefect(const std::vector<std::array<int, 3>>& triangles,
+                        const std::vector<Vec3>& positions, const std::vector<int>& excluded) {
+  const std::size_t n = positions.size();
+  std::vector<double> angleSum(n, 0.0);
+  std::vector<char> skip(n, 0);
+  for (const int v : excluded)
+    if (v >= 0 && static_cast<std::size_t>(v) < n) skip[static_cast<std::size_t>(v)] = 1;
+  // Edges used by one triangle only bound the mesh (the outline, a tear's lips).
+  std::map<std::pair<int, int>, int> edgeUses;
+  for (const auto& tri : triangles)
+    for (std::size_t k = 0; k < 3; ++k) {
+      const int a = tri[k], b = tri[(k + 1) % 3];
+      ++edgeUses[{std::min(a, b), std::max(a, b)}];
+      const Vec3& x = positions[static_cast<std::size_t>(tri[k])];
+      const Vec3 e0 = positions[static_cast<std::size_t>(b)] - x;
+      const Vec3 e1 = positions[static_cast<std::size_t>(tri[(k + 2) % 3])] - x;
+      angleSum[static_cast<std::size_t>(a)] += std::atan2(e0.cross(e1).norm(), e0.dot(e1));
+    }
+  std::vector<char> used(n, 0);
+  for (const auto& tri : triangles)
+    for (const int v : tri) used[static_cast<std::size_t>(v)] = 1;
+  for (const auto& [edge, uses] : edgeUses)
+    if (uses == 1)
+      skip[static_cast<std::size_t>(edge.first)] = skip[static_cast<std::size_t>(edge.second)] = 1;
+  AngleDefect d;
+  for (std::size_t v = 0; v < n; ++v) {
+    if (!used[v] || skip[v]) continue;
+    const double defect = std::abs(2.0 * std::numbers::pi - angleSum[v]);
+    d.total += defect;
+    d.max = std::max(d.max, defect);
+    ++d.vertices;
+  }
+  if (d.vertices > 0) d.mean = d.total / static_cast<double>(d.vertices);
+  return d;
+}
 
 FrameMetrics measureFrame(const cache::FrameRecord& frame) {
   FrameMetrics m;
@@ -66,6 +103,11 @@ FrameMetrics measureFrame(const cache::FrameRecord& frame) {
         std::max(m.handleError,
                  (frame.positions[static_cast<std::size_t>(v)] - frame.handleTargets[h]).norm());
   }
+  const AngleDefect defect = angleDefect(frame.triangles, frame.positions, frame.singularVertices);
+  m.meanAngleDefect = defect.mean;
+  m.maxAngleDefect = defect.max;
+  m.totalAngleDefect = defect.total;
+  m.defectVertices = defect.vertices;
   m.singularVertices = frame.singularVertices.size();
   m.junctionVertices = frame.junctionVertices.size();
   m.tears = frame.tearCount;
@@ -154,6 +196,10 @@ std::string inspectJson(const cache::CacheReader& reader) {
       j.key("contacts").value(m.contacts);
       j.key("max_slide_speed").value(m.maxSlideSpeed);
     }
+    j.key("angle_defect_mean").value(m.meanAngleDefect);
+    j.key("angle_defect_max").value(m.maxAngleDefect);
+    j.key("angle_defect_total").value(m.totalAngleDefect);
+    j.key("angle_defect_vertices").value(m.defectVertices);
     j.endObject();
   }
   j.endArray();

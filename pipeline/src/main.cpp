@@ -7,8 +7,10 @@
 #include <filesystem>
 #include <iostream>
 #include <optional>
+#include <sstream>
 #include <string>
 
+#include "bench_harness.hpp"
 #include "crumple/core/error.hpp"
 #include "crumple/core/parallel.hpp"
 #include "crumple/exporters/exr.hpp"
@@ -60,6 +62,10 @@ struct Args {
   // farm
   pipeline::SlurmOptions slurm;
   bool dryRun = false;
+  // bench
+  bench::BenchOptions bench;
+  std::string benchSamples;
+  bool noProjection = false;
 };
 
 pipeline::RenderSettings renderSettings(const Args& a) {
@@ -224,8 +230,7 @@ int exportCommand(const Args& a) {
   if (!a.frames.empty()) options.frames = pipeline::parseFrameRange(a.frames);
   const auto r = pipeline::exportCache(a.cache, options);
   std::printf("%d frames exported as %s (%zu files) in %.1f ms\n  folder:  %s/\n", r.frames,
-              pipeline::exportFormatName(options.format), r.files.size(), r.ms,
-              r.outDir.c_str());
+              pipeline::exportFormatName(options.format), r.files.size(), r.ms, r.outDir.c_str());
   if (r.tornFrames > 0) std::printf("  tears:   %d frames with a tear texture\n", r.tornFrames);
   for (const auto& n : r.notes) std::printf("  note: %s\n", n.c_str());
   return 0;
@@ -265,6 +270,22 @@ int farmCommand(const Args& a, const CLI::App& slurm) {
       jobs.simulate.c_str(), jobs.render.c_str(), s.chunks.size() - 1, s.frames.first,
       s.frames.last, a.slurm.chunk, jobs.finalize.c_str(), s.farmDir.c_str(), s.logsDir.c_str(),
       s.outDir.c_str());
+  return 0;
+}
+
+// `crumple bench`: speed against error (docs/BENCH.md).
+int benchCommand(Args& a, int argc, char** argv) {
+  if (!a.benchSamples.empty()) {
+    std::string name;
+    for (std::istringstream in(a.benchSamples); std::getline(in, name, ',');)
+      if (!name.empty()) a.bench.samples.push_back(name);
+  }
+  a.bench.projection = !a.noProjection;
+  a.bench.commandLine = "crumple";
+  for (int i = 1; i < argc; ++i) a.bench.commandLine += std::string(" ") + argv[i];
+  bench::runBench(a.bench, std::cerr);
+  std::printf("report: %s/report.md\n  csv:   %s/bench.csv\n  plot:  %s/pareto.png\n",
+              a.bench.outDir.c_str(), a.bench.outDir.c_str(), a.bench.outDir.c_str());
   return 0;
 }
 
@@ -413,6 +434,37 @@ int main(int argc, char** argv) {
       "The finalize job's movie: preview.mp4 beside the cache from the frames already in "
       "frames/ (with sound.wav when there is one), through ffmpeg; renders nothing.");
   farmMovie->add_option("CACHE", a.cache, "a .pcache file")->required();
+  auto* benchCmd = app.add_subcommand(
+      "bench",
+      "Speed against error (docs/BENCH.md): every sample at its own settings, and on the "
+      "paper's examples (cylinder-fold, first-singularity, unload, moebius) the "
+      "hybrid model at 1, 2, 4, 8 substeps against the elastic model on fixed 2 and 1 cm "
+      "meshes at 1, 2, 4 substeps, 0.5 cm at 2 and 4, and on first-singularity (Table II) "
+      "0.25 cm at 2; ms per frame by "
+      "stage beside c_mean, n_comp, angle defect, handle error and the tear errors. One "
+      "thread. Writes DIR/bench.csv, DIR/pareto.png (gnuplot) with each model's Pareto "
+      "front, DIR/report.md beside the paper's Tables II-V (and DIR/table3.csv). About 20 "
+      "minutes with the defaults (30 at most).");
+  benchCmd->add_option("--out", a.bench.outDir, "output folder")->capture_default_str();
+  benchCmd->add_option("--samples", a.benchSamples,
+                       "a,b,...: sample names under samples/ (paper-types/eps-0.5.toml for a "
+                       "variant; default: every sample)");
+  benchCmd
+      ->add_option("--runs", a.bench.runs,
+                   "timed runs per configuration, the median reported (a run over 10 s is "
+                   "timed once)")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  benchCmd->add_option("--frames", a.bench.lastFrame,
+                       "LAST: simulate every configuration up to frame LAST at most");
+  benchCmd->add_flag("--quick", a.bench.quick,
+                     "a small subset for tests: first-singularity and drape up to frame 24 (or "
+                     "--frames), one run, the hybrid model at 1 and 2 substeps, elastic 2 and "
+                     "1 cm meshes at 2");
+  benchCmd->add_flag("--no-projection", a.noProjection,
+                     "skip paper Table III (the isometry projection against Shape-Up)");
+  benchCmd->add_option("--source", a.bench.sourceDir,
+                       "the source tree whose samples/ are run (default: this build's)");
 
   try {
     app.parse(argc, argv);
@@ -436,6 +488,7 @@ int main(int argc, char** argv) {
     if (*compare) return compareCommand(a);
     if (*exportCmd) return exportCommand(a);
     if (*farm) return farmCommand(a, *farmSlurm);
+    if (*benchCmd) return benchCommand(a, argc, argv);
   } catch (const InputError& e) {
     std::fprintf(stderr, "crumple: error: %s\n", e.what());
     return 2;

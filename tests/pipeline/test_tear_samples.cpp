@@ -17,6 +17,7 @@
 #include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/shot.hpp"
+#include "crumple/pipeline/tear_measures.hpp"
 #include "crumple/tear/candidates.hpp"
 #include "crumple/tear/detail_path.hpp"
 #include "test_util.hpp"
@@ -51,17 +52,6 @@ TearShot runTearSample(const std::string& sample, const TempDir& dir, const std:
   const cache::CacheReader reader(shot.report.cachePath);
   shot.last = reader.readFrame(reader.frameCount() - 1);
   return shot;
-}
-
-// The tips s_0, s_1, ... of tear 0 in the pattern (m).
-std::vector<Vec2> tipsOf(const pipeline::ShotReport& r) {
-  std::vector<Vec2> tips;
-  for (const auto& a : r.tearAdvances) {
-    if (a.event.tear != 0) continue;
-    if (tips.empty()) tips.push_back(a.event.from);
-    tips.push_back(a.event.to);
-  }
-  return tips;
 }
 
 // The torn sheet at the last frame: every lip vertex has a twin at the same
@@ -126,18 +116,19 @@ TEST(TearSamples, TearStraightRunsDownTheBisectorOfItsPullingPoints) {
   const auto& r = shot.report;
   ASSERT_EQ(r.tearStartKinds.size(), 1u);
   EXPECT_EQ(r.tearStartKinds[0], tear::CandidateKind::InwardCorner) << "at the notch's root";
-  const std::vector<Vec2> tips = tipsOf(r);
+  const std::vector<Vec2> tips = pipeline::tearTips(r);
   ASSERT_GE(tips.size(), 4u);
   EXPECT_GT((tips.back() - tips.front()).norm(), 0.015) << "the tear runs at least 1.5 cm";
   // The pulling points are mirror images about u = 6 cm: the tear's path,
   // its successive tips s_t, follows that line within 2 % of the sheet
   // width (12 cm). The mesh's cut (snapped to the mesh) and the detail path
   // (the fibers' walk) are reported beside it.
-  double worst = 0.0, cut = 0.0, detail = 0.0;
-  for (const Vec2& q : tips) worst = std::max(worst, std::abs(q.x() - 0.06));
+  const double u = pipeline::kTearStraightBisectorU;
+  const double worst = pipeline::straightTearDeviation(tips, u);
+  double cut = 0.0, detail = 0.0;
   for (const auto& s : r.tearSegments) {
-    for (const Vec2& q : s.cut) cut = std::max(cut, std::abs(q.x() - 0.06));
-    for (const Vec2& q : s.detail) detail = std::max(detail, std::abs(q.x() - 0.06));
+    cut = std::max(cut, pipeline::straightTearDeviation(s.cut, u));
+    detail = std::max(detail, pipeline::straightTearDeviation(s.detail, u));
   }
   std::printf(
       "[ measure ] tear-straight: the tips stray at most %.2f mm (%.2f %% of the width) "
@@ -158,20 +149,10 @@ TEST(TearSamples, TearCurvedBisectsTheDirectionsToItsPullingPoints) {
   // Roman: the tangent at every point c of the path bisects the angle
   // between the directions from the pulling points A and B to c. Sampled at
   // 0.5 mm steps along the tips' polyline.
-  const Vec2 a(0.03, 0.09526279441628825), b(0.075, 0.09526279441628825);
-  const std::vector<Vec2> tips = tipsOf(r);
+  const std::vector<Vec2> tips = pipeline::tearTips(r);
   ASSERT_GE(tips.size(), 3u);
-  std::vector<double> errors;
-  for (std::size_t k = 0; k + 1 < tips.size(); ++k) {
-    const Vec2 d = tips[k + 1] - tips[k];
-    const int n = std::max(1, static_cast<int>(d.norm() / 5e-4));
-    for (int i = 0; i < n; ++i) {
-      const Vec2 c = tips[k] + d * ((i + 0.5) / n);
-      const Vec2 bisector = (c - a).normalized() + (c - b).normalized();
-      errors.push_back(std::acos(std::clamp(bisector.normalized().dot(d.normalized()), -1.0, 1.0)) *
-                       180.0 / std::numbers::pi);
-    }
-  }
+  const std::vector<double> errors =
+      pipeline::hyperbolaAngleErrors(tips, pipeline::kTearCurvedPullA, pipeline::kTearCurvedPullB);
   std::vector<double> sorted = errors;
   std::sort(sorted.begin(), sorted.end());
   const auto at = [&](double q) {

@@ -3,6 +3,7 @@
 // against the pattern (c_mean and n_comp as in paper Table IV), sharpest
 // fold between adjacent triangles, handle error, contacts (the COLL / CONT
 // sub-blocks, exporters/pcache_contacts.hpp).
+#include <array>
 #include <string>
 #include <vector>
 
@@ -25,7 +26,26 @@ struct FrameMetrics {
   std::size_t tears = 0;
   std::size_t contacts = 0;    // records in the frame's CONT block (0 without one)
   double maxSlideSpeed = 0.0;  // largest slide speed among them (m/s)
+  // Developability: the angle defect 2 pi - sum of corner angles (rad) at the
+  // interior vertices that are not singular (0 on a developable surface).
+  double meanAngleDefect = 0.0;    // mean |defect| over them
+  double maxAngleDefect = 0.0;     // max |defect| over them
+  double totalAngleDefect = 0.0;   // sum of |defect| (discrete total |K| dA, resolution-free)
+  std::size_t defectVertices = 0;  // how many were measured
 };
+
+// The angle defect of a triangle mesh (Gauss-Bonnet's discrete curvature):
+// |2 pi - sum of the corner angles| at each vertex that is not on a boundary
+// edge (an edge of one triangle) and not in `excluded` (the singular
+// vertices, where the crumpling model concentrates the curvature).
+struct AngleDefect {
+  double mean = 0.0;   // rad
+  double max = 0.0;    // rad
+  double total = 0.0;  // rad, the sum
+  std::size_t vertices = 0;
+};
+AngleDefect angleDefect(const std::vector<std::array<int, 3>>& triangles,
+                        const std::vector<Vec3>& positions, const std::vector<int>& excluded);
 
 // Throws CorruptDataError naming the frame for a malformed CONT block.
 FrameMetrics measureFrame(const cache::FrameRecord& frame);
@@ -34,6 +54,8 @@ FrameMetrics measureFrame(const cache::FrameRecord& frame);
 // "frames": [...]} -- later features extend it but never rename a key. A
 // cache whose header has COLL adds "colliders": [{"name", "material",
 // "friction"}] and, per frame, "contacts" and "max_slide_speed" (m/s).
+// Every frame has "angle_defect_mean", "angle_defect_max",
+// "angle_defect_total" (rad) and "angle_defect_vertices" (FrameMetrics).
 std::string inspectJson(const cache::CacheReader& reader);
 // The human-readable table (with the colliders and a contacts and a max
 // slide speed column when the header has COLL).

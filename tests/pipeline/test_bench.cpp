@@ -1,0 +1,178 @@
+// `crumple bench` (issue 9, docs/BENCH.md): the Pareto fronts and their
+// verdict on hand-made points, the angle defect (developability) of
+// pipeline::measureFrame on hand-made meshes, and a `bench --quick` run that
+// writes the CSV with both models' rows, the plot and the report.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+#include "crumple/exporters/pcache.hpp"
+#include "crumple/pipeline/inspect.hpp"
+#include "pareto.hpp"
+#include "test_util.hpp"
+
+using namespace crumple;
+using crumple::testing::readFile;
+using crumple::testing::runCrumple;
+using crumple::testing::sourcePath;
+using crumple::testing::TempDir;
+
+namespace {
+
+std::vector<std::string> labels(const std::vector<bench::ParetoPoint>& points) {
+  std::vector<std::string> out;
+  for (const auto& p : points) out.push_back(p.label);
+  return out;
+}
+
+TEST(BenchPareto, TheFrontDropsDominatedPoints) {
+  const std::vector<bench::ParetoPoint> points = {{1.0, 10.0, "a"},
+                                                  {2.0, 5.0, "b"},
+                                                  {3.0, 6.0, "c"},  // c: b is better and cheaper
+                                                  {0.5, 20.0, "d"},
+                                                  {2.0, 5.0, "b again"},
+                                                  {4.0, 5.0, "e"},  // e: as cheap as b, worse
+                                                  {std::nan(""), 1.0, "nan"},
+                                                  {5.0, 1.0, "f"}};
+  EXPECT_EQ(labels(bench::paretoFront(points)), (std::vector<std::string>{"d", "a", "b", "f"}));
+}
+
+TEST(BenchPareto, TheVerdictTakesTheCheapestHybridPointAtEachElasticErrorLevel) {
+  const std::vector<bench::ParetoPoint> hybrid = {
+      {0.5, 2.0, "h1"}, {3.0, 1.0, "h2"}, {0.6, 4.0, "h3"}};
+  const std::vector<bench::ParetoPoint> elastic = {
+      {1.0, 10.0, "e1"}, {2.0, 5.0, "e2"}, {2.5, 7.0, "dominated"}, {4.0, 3.0, "e3"}};
+  const bench::ParetoVerdict v = bench::paretoVerdict(hybrid, elastic);
+  ASSERT_EQ(v.levels.size(), 3u) << "one level per point of the elastic front";
+  EXPECT_EQ(v.levels[0].elastic.label, "e1");
+  ASSERT_TRUE(v.levels[0].hybrid.has_value());
+  EXPECT_EQ(v.levels[0].hybrid->label, "h1");
+  EXPECT_DOUBLE_EQ(v.levels[0].ratio, 5.0);
+  EXPECT_EQ(v.levels[1].hybrid->label, "h1") << "h2 does not reach error 2";
+  EXPECT_DOUBLE_EQ(v.levels[1].ratio, 2.5);
+  EXPECT_EQ(v.levels[2].hybrid->label, "h2");
+  EXPECT_DOUBLE_EQ(v.levels[2].ratio, 3.0);
+  EXPECT_TRUE(v.below);
+
+  // An elastic level no hybrid point reaches, and one where the hybrid point is slower.
+  const bench::ParetoVerdict unreached =
+      bench::paretoVerdict(hybrid, {{0.1, 50.0, "fine"}, {4.0, 3.0, "e3"}});
+  EXPECT_FALSE(unreached.levels[0].hybrid.has_value());
+  EXPECT_FALSE(unreached.below);
+  const bench::ParetoVerdict slower = bench::paretoVerdict(hybrid, {{1.0, 1.5, "cheap"}});
+  EXPECT_DOUBLE_EQ(slower.levels[0].ratio, 0.75);
+  EXPECT_FALSE(slower.below);
+  EXPECT_FALSE(bench::paretoVerdict(hybrid, {}).below) << "no elastic point: nothing measured";
+}
+
+// A frame of a hand-made mesh (the pattern is the positions' x, y).
+cache::FrameRecord frameOf(std::vector<Vec3> positions, std::vector<std::array<int, 3>> triangles) {
+  cache::FrameRecord f;
+  for (const Vec3& p : positions) f.pattern.emplace_back(p.x(), p.y());
+  f.positions = std::move(positions);
+  f.triangles = std::move(triangles);
+  return f;
+}
+
+// An n x n grid of unit squares, two triangles each, lifted by `z`(x, y).
+template <class Z>
+cache::FrameRecord grid(int n, Z z) {
+  std::vector<Vec3> p;
+  std::vector<std::array<int, 3>> t;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) p.emplace_back(i, j, z(i, j));
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i, b = a + 1, c = a + n + 1, d = c + 1;
+      t.push_back({a, b, d});
+      t.push_back({a, d, c});
+    }
+  return frameOf(p, t);
+}
+
+TEST(BenchAngleDefect, AFlatOrFoldedSheetHasNone) {
+  const auto flat = pipeline::measureFrame(grid(3, [](int, int) { return 0.0; }));
+  EXPECT_EQ(flat.defectVertices, 4u) << "the 2 x 2 interior vertices of a 3 x 3 grid";
+  EXPECT_LT(flat.maxAngleDefect, 1e-12);
+  // Folded along x = 1 (a developable crease): still no defect.
+  const auto folded =
+      pipeline::measureFrame(grid(3, [](int i, int) { return i > 1 ? 0.7 * (i - 1) : 0.0; }));
+  EXPECT_EQ(folded.defectVertices, 4u);
+  EXPECT_LT(folded.maxAngleDefect, 1e-12);
+  // Bumped in the middle (doubly curved): a defect at the interior vertices.
+  const auto bumped =
+      pipeline::measureFrame(grid(3, [](int i, int j) { return i == 1 && j == 1 ? 0.5 : 0.0; }));
+  EXPECT_GT(bumped.maxAngleDefect, 0.05);
+}
+
+TEST(BenchAngleDefect, APyramidApexHasItsKnownDefectAndIsExcludedWhenSingular) {
+  const double h = 0.8;
+  cache::FrameRecord pyramid = frameOf({{0, 0, h}, {1, 1, 0}, {-1, 1, 0}, {-1, -1, 0}, {1, -1, 0}},
+                                       {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 1}});
+  // Each face's apex angle: between (1, 1, -h) and (-1, 1, -h).
+  const Vec3 u(1, 1, -h), v(-1, 1, -h);
+  const double apex = std::acos(u.dot(v) / (u.norm() * v.norm()));
+  const auto m = pipeline::measureFrame(pyramid);
+  EXPECT_EQ(m.defectVertices, 1u) << "the base corners are on the boundary";
+  EXPECT_NEAR(m.maxAngleDefect, 2.0 * std::numbers::pi - 4.0 * apex, 1e-12);
+  EXPECT_NEAR(m.meanAngleDefect, m.maxAngleDefect, 1e-15);
+  EXPECT_NEAR(m.totalAngleDefect, m.maxAngleDefect, 1e-15);
+  pyramid.singularVertices = {0};
+  const auto singular = pipeline::measureFrame(pyramid);
+  EXPECT_EQ(singular.defectVertices, 0u) << "a singular vertex is not measured";
+  EXPECT_EQ(singular.maxAngleDefect, 0.0);
+}
+
+TEST(BenchAngleDefect, InspectJsonHasTheNewKeys) {
+  const TempDir dir;
+  const auto sim = runCrumple("simulate " + sourcePath("samples/drape") + " --frames 0-2 --out " +
+                              (dir / "drape").string());
+  ASSERT_EQ(sim.status, 0) << sim.output;
+  const auto r = runCrumple("inspect --json " + (dir / "drape" / "cache.pcache").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  for (const char* key : {"\"angle_defect_mean\"", "\"angle_defect_max\"", "\"angle_defect_total\"",
+                          "\"angle_defect_vertices\"", "\"c_mean\"", "\"handle_error\""})
+    EXPECT_NE(r.output.find(key), std::string::npos) << key;
+}
+
+TEST(BenchCommand, QuickWritesTheCsvThePlotAndTheReport) {
+  const TempDir dir;
+  const std::string out = (dir / "bench").string();
+  const auto r = runCrumple("bench --quick --no-projection --out " + out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("bench [1/"), std::string::npos) << "progress, one line per run";
+  // The CSV: a header and both models' rows on first-singularity.
+  std::istringstream csv(readFile(out + "/bench.csv"));
+  std::string header, line;
+  std::getline(csv, header);
+  EXPECT_EQ(header.rfind("sample,role,model,edge_cm,substeps", 0), 0u) << header;
+  for (const char* column : {"ms_total", "c_mean_mean_pct", "n_comp_max_pct",
+                             "angle_defect_mean_rad", "angle_defect_max_rad", "handle_error_max_m",
+                             "tear_straight_dev_pct", "tear_hyperbola_median_deg", "status"})
+    EXPECT_NE(header.find(column), std::string::npos) << column;
+  int hybrid = 0, elastic = 0;
+  while (std::getline(csv, line)) {
+    if (line.rfind("first-singularity,", 0) != 0) continue;
+    hybrid += line.find(",hybrid,") != std::string::npos;
+    elastic += line.find(",elastic,") != std::string::npos;
+    EXPECT_NE(line.find(",ok"), std::string::npos) << line;
+  }
+  EXPECT_GE(hybrid, 2);
+  EXPECT_GE(elastic, 2);
+  // The plot: a PNG.
+  const std::string png = readFile(out + "/pareto.png");
+  ASSERT_GT(png.size(), 1000u);
+  EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  // The report: the verdicts and the paper's tables beside ours.
+  const std::string report = readFile(out + "/report.md");
+  for (const char* part :
+       {"## The Pareto verdict", "### first-singularity, c_mean", "## Paper Table II",
+        "## Paper Table IV", "## Paper Table V", "| Fig. 1 | `cylinder-fold`"})
+    EXPECT_NE(report.find(part), std::string::npos) << part;
+  EXPECT_TRUE(report.find(": below\n") != std::string::npos ||
+              report.find(": not below\n") != std::string::npos);
+}
+
+}  // namespace
