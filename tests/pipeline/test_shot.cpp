@@ -241,6 +241,16 @@ TEST(HandleRig, TangentVerticesFollowTheNodeRotation) {
   }
 }
 
+// Handle A jumps ~10 km up between two frames (t = 0.1 s and 0.125 s); B stays.
+void writeJumpAnimation(const fs::path& dir) {
+  fs::create_directories(dir);
+  GltfTrack a{"A",
+              {0.0f, 0.1f, 0.125f},
+              {{-0.05f, 0.2f, 0.0f}, {-0.05f, 0.2f, 0.0f}, {-0.05f, 1e4f, 0.0f}}};
+  GltfTrack b{"B", {}, {{0.05f, 0.2f, 0.0f}}};
+  writeFile(dir / "anim.gltf", makeGltf({a, b}));
+}
+
 TEST(Shot, NumericalFailureNamesFrameAndKeepsTheCacheValid) {
   // A handle that jumps ~10 km between two frames on a sheet without the
   // reach limit (an outline pattern: HandleRig::reachExcess is off there):
@@ -248,12 +258,7 @@ TEST(Shot, NumericalFailureNamesFrameAndKeepsTheCacheValid) {
   // stop with a NumericalError naming the frame and the stage, and the
   // cache must hold every frame before it.
   TempDir tmp;
-  fs::create_directories(tmp / "s");
-  GltfTrack a{"A",
-              {0.0f, 0.1f, 0.125f},
-              {{-0.05f, 0.2f, 0.0f}, {-0.05f, 0.2f, 0.0f}, {-0.05f, 1e4f, 0.0f}}};
-  GltfTrack b{"B", {}, {{0.05f, 0.2f, 0.0f}}};
-  writeFile(tmp / "s/anim.gltf", makeGltf({a, b}));
+  writeJumpAnimation(tmp / "s");
   std::string scene =
       smallSceneToml("outline = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]\n");
   scene.erase(scene.find("width = 10.0\nheight = 10.0\n"), 26);
@@ -280,12 +285,7 @@ TEST(Shot, AHandleBeyondTheSheetsReachLagsAndIsNamed) {
   // holds the jumping handle at its pattern distance from the other, so the
   // shot finishes with finite values and the summary names the handle.
   TempDir tmp;
-  fs::create_directories(tmp / "s");
-  GltfTrack a{"A",
-              {0.0f, 0.1f, 0.125f},
-              {{-0.05f, 0.2f, 0.0f}, {-0.05f, 0.2f, 0.0f}, {-0.05f, 1e4f, 0.0f}}};
-  GltfTrack b{"B", {}, {{0.05f, 0.2f, 0.0f}}};
-  writeFile(tmp / "s/anim.gltf", makeGltf({a, b}));
+  writeJumpAnimation(tmp / "s");
   writeFile(tmp / "s/scene.toml", smallSceneToml());
   const auto spec = io::loadScene((tmp / "s/scene.toml").string());
   const auto report = pipeline::runShot(spec, quiet(tmp / "out"));
