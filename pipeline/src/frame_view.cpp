@@ -11,6 +11,7 @@
 #include "crumple/core/error.hpp"
 #include "crumple/exporters/pcache_tear.hpp"
 #include "crumple/exporters/png.hpp"
+#include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/shot.hpp"
 
 namespace crumple::pipeline {
@@ -71,6 +72,8 @@ const cache::ExtensionBlock* findBlock(const std::vector<cache::ExtensionBlock>&
   return nullptr;
 }
 
+}  // namespace
+
 mesh::SheetMesh sheetOfFrame(const cache::FrameRecord& frame) {
   mesh::SheetMesh m;
   m.pattern = frame.pattern;
@@ -80,8 +83,6 @@ mesh::SheetMesh sheetOfFrame(const cache::FrameRecord& frame) {
   for (auto t : frame.regionTypes) m.regionTypes.push_back(static_cast<mesh::RegionType>(t));
   return m;
 }
-
-}  // namespace
 
 render::RenderScene makeRenderScene(const io::SceneSpec& scene, const cache::CameraRecord& camera) {
   render::RenderScene view;

@@ -146,12 +146,7 @@ void checkCache(const fs::path& cache, const Bounds& bounds, Outcome& o) {
         o.problems.push_back(at + "non-finite position");
         break;
       }
-    mesh::SheetMesh m;
-    m.pattern = f.pattern;
-    m.positions = f.positions;
-    m.triangles = f.triangles;
-    m.regionOfTriangle = f.regionOfTriangle;
-    for (auto t : f.regionTypes) m.regionTypes.push_back(static_cast<mesh::RegionType>(t));
+    const mesh::SheetMesh m = pipeline::sheetOfFrame(f);
     if (const std::string bad = mesh::validate(m); !bad.empty())
       o.problems.push_back(at + "mesh::validate: " + bad);
     for (const auto& t : f.triangles) {

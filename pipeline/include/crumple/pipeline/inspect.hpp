@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "crumple/exporters/pcache.hpp"
+#include "crumple/mesh/sheet_mesh.hpp"
 
 namespace crumple::pipeline {
 
@@ -49,6 +50,9 @@ AngleDefect angleDefect(const std::vector<std::array<int, 3>>& triangles,
 
 // Throws CorruptDataError naming the frame for a malformed CONT block.
 FrameMetrics measureFrame(const cache::FrameRecord& frame);
+// The cached frame as a sheet mesh (pattern, positions, triangles, regions),
+// e.g. for mesh::validate.
+mesh::SheetMesh sheetOfFrame(const cache::FrameRecord& frame);
 
 // The `inspect --json` object: {"format_version", "fps", "frame_count",
 // "frames": [...]} -- later features extend it but never rename a key. A
