@@ -45,15 +45,21 @@ struct ElasticMesh {
   std::string onlySample;  // non-empty: on this sample only
 };
 struct SweepPlan {
-  std::vector<int> hybridSubsteps;
+  std::vector<int> hybridSubsteps;  // at the sample's length sweeps
+  // The isometry's length sweeps (`[model] isometry_length_sweeps`), each at
+  // every count of hybridSweepSubsteps: the hybrid model's accuracy knob.
+  std::vector<int> hybridLengthSweeps;
+  std::vector<int> hybridSweepSubsteps;
   std::vector<ElasticMesh> elastic;
 };
 
 SweepPlan sweepPlan(bool quick) {
-  if (quick) return {{1, 2}, {{2.0, {2}, ""}, {1.0, {2}, ""}}};
+  if (quick) return {{1, 2}, {3000}, {1}, {{2.0, {2}, ""}, {1.0, {2}, ""}}};
   // The 0.5 cm mesh at one substep needs many halvings (cylinder-fold: 1.5 s per
   // frame); the 0.25 cm mesh stands for the paper's dense FEM of Table II only.
   return {{1, 2, 4, 8},
+          {1000, 3000, 10000, 30000},
+          {1, 2},
           {{2.0, {1, 2, 4}, ""},
            {1.0, {1, 2, 4}, ""},
            {0.5, {2, 4}, ""},
@@ -88,7 +94,8 @@ double meshEdge(const io::SceneSpec& s) {
   return s.sheet.maxEdge > 0.0 ? s.sheet.maxEdge : std::min(s.sheet.width, s.sheet.height) / 16.0;
 }
 
-// Estimated cost: frames x substeps x triangles (S_P holds about 150).
+// Estimated cost: frames x substeps x triangles (S_P holds about 150), and
+// for the hybrid model the length sweeps.
 double estimateWeight(const io::SceneSpec& s) {
   const double frames = static_cast<double>(s.frameEnd - s.frameStart + 1);
   double triangles = 150.0;
@@ -96,7 +103,12 @@ double estimateWeight(const io::SceneSpec& s) {
     const double e = meshEdge(s);
     triangles = std::max(50.0, 2.0 * std::ceil(s.sheet.width / e) * std::ceil(s.sheet.height / e));
   }
-  return frames * s.substeps * triangles;
+  // The isometry's length sweeps dominate a hybrid step beyond a few
+  // thousand (moebius at one substep: 2.4 ms per frame at 300, 40 at 30000).
+  const double sweeps = s.model.type == io::ModelSpec::Type::Hybrid
+                            ? static_cast<double>(s.model.hybrid.isometryLengthSweeps)
+                            : 0.0;
+  return frames * s.substeps * triangles * (1.0 + sweeps / 2000.0);
 }
 
 double percentile(std::vector<double> v, double q) {
@@ -204,7 +216,9 @@ std::string fileSafe(std::string s) {
 
 std::string BenchRow::label() const {
   char text[64];
-  if (model == "hybrid")
+  if (model == "hybrid" && lengthSweeps != io::HybridSpec{}.isometryLengthSweeps)
+    std::snprintf(text, sizeof text, "hybrid x%d, %d sweeps", substeps, lengthSweeps);
+  else if (model == "hybrid")
     std::snprintf(text, sizeof text, "hybrid x%d", substeps);
   else
     std::snprintf(text, sizeof text, "elastic %.2f cm x%d", edgeCm, substeps);
@@ -251,6 +265,7 @@ std::vector<BenchRow> runBench(const BenchOptions& options, std::ostream& progre
     own.model = hybrid ? "hybrid" : "elastic";
     own.edgeCm = hybrid ? 0.0 : 100.0 * meshEdge(scene);
     own.substeps = scene.substeps;
+    own.lengthSweeps = hybrid ? scene.model.hybrid.isometryLengthSweeps : 0;
     add(scene, own);
     if (!hybrid ||
         std::find(kSweepSamples.begin(), kSweepSamples.end(), name) == kSweepSamples.end())
@@ -263,6 +278,17 @@ std::vector<BenchRow> runBench(const BenchOptions& options, std::ostream& progre
       row.substeps = s;
       add(h, row);
     }
+    for (const int sweeps : plan.hybridLengthSweeps)
+      for (const int s : plan.hybridSweepSubsteps) {
+        io::SceneSpec h = scene;
+        h.substeps = s;
+        h.model.hybrid.isometryLengthSweeps = sweeps;
+        BenchRow row = own;
+        row.role = "sweep";
+        row.substeps = s;
+        row.lengthSweeps = sweeps;
+        add(h, row);
+      }
     const auto addElastic = [&](double edgeCm, int substeps) {
       io::SceneSpec e = scene;
       e.model.type = io::ModelSpec::Type::Elastic;
@@ -272,6 +298,7 @@ std::vector<BenchRow> runBench(const BenchOptions& options, std::ostream& progre
       row.role = "sweep";
       row.model = "elastic";
       row.edgeCm = edgeCm;
+      row.lengthSweeps = 0;
       row.substeps = substeps;
       add(e, row);
     };

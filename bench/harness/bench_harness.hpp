@@ -1,7 +1,7 @@
 #pragma once
 // `crumple bench` (issue 9, docs/BENCH.md): every sample at its own settings,
-// and on the paper's examples the hybrid model at several substep counts
-// against the plain elastic model on fixed meshes at several resolutions;
+// and on the paper's examples the hybrid model at several substep counts and
+// isometry length sweeps against the plain elastic model on fixed meshes at several resolutions;
 // ms per frame by stage beside the error measures. Writes bench.csv,
 // pareto.png (gnuplot) and report.md (beside the paper's Tables II-V).
 #include <map>
@@ -30,9 +30,10 @@ struct BenchRow {
   std::string model;    // "hybrid" or "elastic"
   double edgeCm = 0.0;  // the elastic mesh's max edge (0: the hybrid model's adaptive S_P)
   int substeps = 0;
-  int frames = 0;                            // frames simulated
-  int runs = 0;                              // timed runs
-  double trianglesMean = 0.0;                // of the cached mesh, mean over frames
+  int lengthSweeps = 0;        // hybrid: the isometry's length sweeps per step (0 for elastic)
+  int frames = 0;              // frames simulated
+  int runs = 0;                // timed runs
+  double trianglesMean = 0.0;  // of the cached mesh, mean over frames
   std::map<std::string, double> msPerFrame;  // stage -> ms/frame
   double msTotal = 0.0;                      // the simulation (every stage but cache, render)
   double newtonPerSubstep = 0.0;
@@ -46,7 +47,9 @@ struct BenchRow {
   double tearHyperbolaMedian = -1.0, tearHyperbolaP90 = -1.0;  // deg (tear-curved; < 0: n/a)
   std::string status = "ok";                                   // or why the run stopped early
   bool ok() const { return status == "ok"; }
-  std::string label() const;  // e.g. "hybrid x2", "elastic 0.50 cm x4"
+  // e.g. "hybrid x2", "hybrid x1, 3000 sweeps" (away from the default 300),
+  // "elastic 0.50 cm x4".
+  std::string label() const;
 };
 
 // The stage columns of bench.csv, in order.

@@ -438,13 +438,14 @@ int main(int argc, char** argv) {
       "bench",
       "Speed against error (docs/BENCH.md): every sample at its own settings, and on the "
       "paper's examples (cylinder-fold, first-singularity, unload, moebius) the "
-      "hybrid model at 1, 2, 4, 8 substeps against the elastic model on fixed 2 and 1 cm "
+      "hybrid model at 1, 2, 4, 8 substeps, and at 1 and 2 with 1000, 3000, 10000 and 30000 "
+      "isometry length sweeps, against the elastic model on fixed 2 and 1 cm "
       "meshes at 1, 2, 4 substeps, 0.5 cm at 2 and 4, and on first-singularity (Table II) "
       "0.25 cm at 2; ms per frame by "
       "stage beside c_mean, n_comp, angle defect, handle error and the tear errors. One "
       "thread. Writes DIR/bench.csv, DIR/pareto.png (gnuplot) with each model's Pareto "
-      "front, DIR/report.md beside the paper's Tables II-V (and DIR/table3.csv). About 20 "
-      "minutes with the defaults (30 at most).");
+      "front, DIR/report.md beside the paper's Tables II-V (and DIR/table3.csv). About 25 "
+      "minutes with the defaults (35 at most).");
   benchCmd->add_option("--out", a.bench.outDir, "output folder")->capture_default_str();
   benchCmd->add_option("--samples", a.benchSamples,
                        "a,b,...: sample names under samples/ (paper-types/eps-0.5.toml for a "

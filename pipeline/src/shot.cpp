@@ -135,6 +135,8 @@ paper::CrumpleParams crumpleParamsOf(const io::HybridSpec& h) {
   p.thetaRest = h.thetaRest;
   p.damage = h.damage;
   p.isometryIterations = h.isometryIterations;
+  p.isometryLengthSweeps = h.isometryLengthSweeps;
+  p.isometryLengthTolerance = h.isometryLengthTolerance;
   p.maxSingularPerFrame = h.maxSingularPerFrame;
   p.remeshCooldown = h.remeshCooldown;
   // Region invariants after every geometric step: always in debug builds,

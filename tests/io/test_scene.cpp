@@ -472,6 +472,8 @@ TEST(SceneModel, HybridDefaultsAreTheSeeds) {
   EXPECT_DOUBLE_EQ(h.thetaRest, kPi / 8.0);
   EXPECT_DOUBLE_EQ(h.damage, 10.0);
   EXPECT_EQ(h.isometryIterations, 200);
+  EXPECT_EQ(h.isometryLengthSweeps, 300);
+  EXPECT_DOUBLE_EQ(h.isometryLengthTolerance, 1e-6);
   // A scene without [model] carries the same defaults.
   const HybridSpec d = parse(kSheet).model.hybrid;
   EXPECT_DOUBLE_EQ(d.rhoBound, h.rhoBound);
@@ -495,6 +497,8 @@ TEST(SceneModel, EveryKeyParsedAndConvertedToSI) {
       "theta_rest = 0.5\n"
       "damage = 4\n"
       "isometry_iterations = 50\n"
+      "isometry_length_sweeps = 0\n"
+      "isometry_length_tolerance = 1e-9\n"
       "max_singular_per_frame = 5\n"
       "remesh_cooldown = 0\n");
   const HybridSpec& h = s.model.hybrid;
@@ -510,6 +514,8 @@ TEST(SceneModel, EveryKeyParsedAndConvertedToSI) {
   EXPECT_DOUBLE_EQ(h.thetaRest, 0.5);
   EXPECT_DOUBLE_EQ(h.damage, 4.0);
   EXPECT_EQ(h.isometryIterations, 50);
+  EXPECT_EQ(h.isometryLengthSweeps, 0);
+  EXPECT_DOUBLE_EQ(h.isometryLengthTolerance, 1e-9);
   EXPECT_EQ(h.maxSingularPerFrame, 5);
   EXPECT_EQ(h.remeshCooldown, 0);
 }
@@ -578,6 +584,14 @@ TEST(SceneErrors, Model) {
               {"[1, 100000]"});
   expectError(head + "isometry_iterations = 20.5\n", 6, "model.isometry_iterations",
               {"expected an integer"});
+  expectError(head + "isometry_length_sweeps = -1\n", 6, "model.isometry_length_sweeps",
+              {"[0, 100000]", "got -1"});
+  expectError(head + "isometry_length_sweeps = 1e3\n", 6, "model.isometry_length_sweeps",
+              {"expected an integer"});
+  expectError(head + "isometry_length_tolerance = 0\n", 6, "model.isometry_length_tolerance",
+              {"(0, 0.1)"});
+  expectError(head + "isometry_length_tolerance = 0.5\n", 6, "model.isometry_length_tolerance",
+              {"(0, 0.1)", "got 0.5"});
   expectError(head + "max_singular_per_frame = -1\n", 6, "model.max_singular_per_frame",
               {"[0, 1000]", "got -1"});
   expectError(head + "remesh_cooldown = 2.5\n", 6, "model.remesh_cooldown",

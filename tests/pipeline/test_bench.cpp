@@ -152,14 +152,18 @@ TEST(BenchCommand, QuickWritesTheCsvThePlotAndTheReport) {
                              "angle_defect_mean_rad", "angle_defect_max_rad", "handle_error_max_m",
                              "tear_straight_dev_pct", "tear_hyperbola_median_deg", "status"})
     EXPECT_NE(header.find(column), std::string::npos) << column;
-  int hybrid = 0, elastic = 0;
+  EXPECT_EQ(header.rfind("sample,role,model,edge_cm,substeps,length_sweeps", 0), 0u) << header;
+  int hybrid = 0, elastic = 0, sweeps = 0;
   while (std::getline(csv, line)) {
     if (line.rfind("first-singularity,", 0) != 0) continue;
     hybrid += line.find(",hybrid,") != std::string::npos;
+    // The hybrid model's accuracy knob: 3000 isometry length sweeps at one substep.
+    sweeps += line.find(",sweep,hybrid,,1,3000,") != std::string::npos;
     elastic += line.find(",elastic,") != std::string::npos;
     EXPECT_NE(line.find(",ok"), std::string::npos) << line;
   }
-  EXPECT_GE(hybrid, 2);
+  EXPECT_GE(hybrid, 3);
+  EXPECT_EQ(sweeps, 1);
   EXPECT_GE(elastic, 2);
   // The plot: a PNG.
   const std::string png = readFile(out + "/pareto.png");
@@ -167,9 +171,9 @@ TEST(BenchCommand, QuickWritesTheCsvThePlotAndTheReport) {
   EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
   // The report: the verdicts and the paper's tables beside ours.
   const std::string report = readFile(out + "/report.md");
-  for (const char* part :
-       {"## The Pareto verdict", "### first-singularity, c_mean", "## Paper Table II",
-        "## Paper Table IV", "## Paper Table V", "| Fig. 1 | `cylinder-fold`"})
+  for (const char* part : {"## The Pareto verdict", "### first-singularity, c_mean",
+                           "## Paper Table II", "## Paper Table IV", "## Paper Table V",
+                           "| Fig. 1 | `cylinder-fold`", "hybrid x1, 3000 sweeps"})
     EXPECT_NE(report.find(part), std::string::npos) << part;
   EXPECT_TRUE(report.find(": below\n") != std::string::npos ||
               report.find(": not below\n") != std::string::npos);

@@ -869,11 +869,14 @@ class SceneParser {
                                                        "theta_rest",
                                                        "damage",
                                                        "isometry_iterations",
+                                                       "isometry_length_sweeps",
+                                                       "isometry_length_tolerance",
                                                        "max_singular_per_frame",
                                                        "remesh_cooldown"};
     r.allowOnly({"type", "rho_bound_per_cm", "rho_int_per_cm2", "theta0", "theta_low", "theta_high",
                  "eps_blaschke", "eps_c", "sigma_cm", "theta_rest", "damage", "isometry_iterations",
-                 "max_singular_per_frame", "remesh_cooldown"});
+                 "isometry_length_sweeps", "isometry_length_tolerance", "max_singular_per_frame",
+                 "remesh_cooldown"});
     ModelSpec& m = spec_.model;
     m.typeLine = r.lineOf("type");
     const std::string type = r.string("type").value_or("elastic");
@@ -950,6 +953,20 @@ class SceneParser {
                                           "] (got " + std::to_string(*n) + ")");
       }
       h.isometryIterations = static_cast<int>(*n);
+    }
+    // The isometry's Gauss-Seidel length sweeps after Phase II and their
+    // early-exit tolerance (isometry.hpp deviation 7); 0 sweeps keeps the
+    // paper's projection alone.
+    if (auto n = r.integer("isometry_length_sweeps")) {
+      if (*n < 0 || *n > kMaxIsometryIterations) {
+        r.fail("isometry_length_sweeps", "must be in [0, " +
+                                             std::to_string(kMaxIsometryIterations) + "] (got " +
+                                             std::to_string(*n) + ")");
+      }
+      h.isometryLengthSweeps = static_cast<int>(*n);
+    }
+    if (auto v = r.number("isometry_length_tolerance")) {
+      h.isometryLengthTolerance = inRange("isometry_length_tolerance", *v, 0.0, 0.1, false);
     }
     // How fast the sheet may crumple: new singular vertices per frame, and
     // animation steps a remeshed region waits before it is remeshed again.

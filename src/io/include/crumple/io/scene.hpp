@@ -229,6 +229,8 @@ struct HybridSpec {
   double thetaRest = 0.39269908169872414;  // rad, pi / 8 (thesis eq. 2.1)
   double damage = 10.0;                    // fiber damage D (thesis eq. 2.2)
   int isometryIterations = 200;            // Phase I iteration cap (paper Sec. 6.3)
+  int isometryLengthSweeps = 300;          // length sweeps after Phase II (our extension)
+  double isometryLengthTolerance = 1e-6;   // their early exit: worst relative edge error
   int maxSingularPerFrame = 2;             // new singular vertices per frame at most
   int remeshCooldown = 3;                  // animation steps a remeshed region waits
 };

@@ -68,8 +68,8 @@
 //     translated so its vertex centroid equals the input's. Vertices in no
 //     triangle are left where they are.
 //  7. Gauss-Seidel length sweeps (IsometryOptions::lengthSweeps; 0 here,
-//     300 in HybridSheet): after the last Phase II every edge in turn is
-//     projected onto its pattern length, its free ends moved equally along
+//     300 in HybridSheet, a scene's `[model] isometry_length_sweeps`): after the last Phase II
+//     every edge in turn is projected onto its pattern length, its free ends moved equally along
 //     it, fixed vertices immobile (the distance projection of position-based
 //     dynamics). Phase I + II is a global step that stalls where the coarse
 //     S_P of the crumpling samples meets its handles; the sweeps remove the

@@ -34,7 +34,8 @@ struct CrumpleParams {
   int isometryIterations = 200;               // Phase I iteration cap (paper Sec. 6.3)
   int isometryRounds = 1;  // Phase I + II passes per step (IsometryOptions::rounds)
   // Gauss-Seidel edge-length sweeps after Phase II and their early-exit
-  // tolerance (IsometryOptions::lengthSweeps, isometry.hpp deviation 7).
+  // tolerance (IsometryOptions::lengthSweeps, isometry.hpp deviation 7): the
+  // model's accuracy knob (docs/BENCH.md), `[model] isometry_length_sweeps`.
   int isometryLengthSweeps = 300;
   double isometryLengthTolerance = 1e-6;
   // Whether the isometry also holds the handles' tangent-plane pins; by
