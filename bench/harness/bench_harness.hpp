@@ -1,7 +1,8 @@
 #pragma once
 // `crumple bench` (issue 9, docs/BENCH.md): every sample at its own settings,
 // and on the paper's examples the hybrid model at several substep counts and
-// isometry length sweeps against the plain elastic model on fixed meshes at several resolutions;
+// isometry length sweeps against the plain elastic model on fixed meshes at
+// several resolutions;
 // ms per frame by stage beside the error measures. Writes bench.csv,
 // pareto.png (gnuplot) and report.md (beside the paper's Tables II-V).
 #include <map>

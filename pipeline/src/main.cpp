@@ -444,8 +444,8 @@ int main(int argc, char** argv) {
       "0.25 cm at 2; ms per frame by "
       "stage beside c_mean, n_comp, angle defect, handle error and the tear errors. One "
       "thread. Writes DIR/bench.csv, DIR/pareto.png (gnuplot) with each model's Pareto "
-      "front, DIR/report.md beside the paper's Tables II-V (and DIR/table3.csv). About 25 "
-      "minutes with the defaults (35 at most).");
+      "front, DIR/report.md beside the paper's Tables II-V (and DIR/table3.csv). About 20 "
+      "minutes with the defaults (30 at most).");
   benchCmd->add_option("--out", a.bench.outDir, "output folder")->capture_default_str();
   benchCmd->add_option("--samples", a.benchSamples,
                        "a,b,...: sample names under samples/ (paper-types/eps-0.5.toml for a "

@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iterator>
 #include <numbers>
 #include <optional>
 #include <set>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -873,10 +875,9 @@ class SceneParser {
                                                        "isometry_length_tolerance",
                                                        "max_singular_per_frame",
                                                        "remesh_cooldown"};
-    r.allowOnly({"type", "rho_bound_per_cm", "rho_int_per_cm2", "theta0", "theta_low", "theta_high",
-                 "eps_blaschke", "eps_c", "sigma_cm", "theta_rest", "damage", "isometry_iterations",
-                 "isometry_length_sweeps", "isometry_length_tolerance", "max_singular_per_frame",
-                 "remesh_cooldown"});
+    std::vector<std::string_view> allowed = {"type"};
+    allowed.insert(allowed.end(), std::begin(kHybridKeys), std::end(kHybridKeys));
+    r.allowOnly(allowed);
     ModelSpec& m = spec_.model;
     m.typeLine = r.lineOf("type");
     const std::string type = r.string("type").value_or("elastic");

@@ -75,6 +75,10 @@ TableReader::TableReader(const toml::table& table, std::string path, std::string
     : table_(table), path_(std::move(path)), file_(std::move(file)) {}
 
 void TableReader::allowOnly(std::initializer_list<std::string_view> allowed) const {
+  allowOnly(std::span<const std::string_view>(allowed.begin(), allowed.size()));
+}
+
+void TableReader::allowOnly(std::span<const std::string_view> allowed) const {
   // Report the first offending key in file order (toml++ tables are sorted by key).
   const toml::key* worst = nullptr;
   for (auto&& [k, v] : table_) {

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <initializer_list>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -33,6 +34,7 @@ class TableReader {
 
   // Throws for the first key (in file order) that is not in `allowed`.
   void allowOnly(std::initializer_list<std::string_view> allowed) const;
+  void allowOnly(std::span<const std::string_view> allowed) const;
 
   const toml::table& table() const { return table_; }
   const std::string& file() const { return file_; }
