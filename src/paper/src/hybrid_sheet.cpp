@@ -620,7 +620,11 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
     m.isometry.emplace(m.sp.mesh.pattern, m.sp.mesh.triangles, fixed, m.isometryOptions());
   }
   if (m.onProjection) {
-    m.onProjection({m.sp.mesh.pattern, m.sp.mesh.triangles, fixed, m.sp.mesh.positions,
+    std::vector<int> all;
+    for (const sim::Pin& p : pinned) all.push_back(p.vertex);
+    std::sort(all.begin(), all.end());
+    all.erase(std::unique(all.begin(), all.end()), all.end());
+    m.onProjection({m.sp.mesh.pattern, m.sp.mesh.triangles, fixed, all, m.sp.mesh.positions,
                     m.isometryOptions(), m.params.isometryIterations, frame, t + dt});
   }
   std::vector<Vec3> positions = m.sp.mesh.positions;

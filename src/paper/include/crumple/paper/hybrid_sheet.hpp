@@ -52,6 +52,9 @@ struct ProjectionInput {
   const std::vector<Vec2>& pattern;
   const std::vector<std::array<int, 3>>& triangles;
   const std::vector<int>& fixed;
+  // Every vertex the handle rig pins at the step's end (handles and their
+  // tangent-plane vertices), sorted; `fixed` is the part the projection holds.
+  const std::vector<int>& pinned;
   const std::vector<Vec3>& positions;
   IsometryOptions options;
   int maxIterations = 0;
