@@ -27,6 +27,8 @@
 //
 // Usage: bench_dof SCENE [--frames 42,60,90] [--model "key = value"]...
 //        [--iterations 400]
+#include <unistd.h>
+
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
@@ -340,7 +342,9 @@ int main(int argc, char** argv) {
     std::map<int, Capture> captured;
     const std::set<int> wanted(frames.begin(), frames.end());
     crumple::pipeline::ShotOptions options;
-    options.outDir = (fs::temp_directory_path() / "crumple-bench-dof").string();
+    // One folder per process: runs side by side do not share it.
+    options.outDir =
+        (fs::temp_directory_path() / ("crumple-bench-dof-" + std::to_string(::getpid()))).string();
     options.render = false;
     options.log = nullptr;
     options.interactive = 0;
