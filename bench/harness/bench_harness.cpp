@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -122,8 +123,13 @@ void measureCache(const std::string& cachePath, BenchRow& row) {
   const cache::CacheReader reader(cachePath);
   const std::size_t n = reader.frameCount();
   double triangles = 0.0, cMean = 0.0, nComp = 0.0, defect = 0.0, total = 0.0;
+  std::optional<cache::FrameRecord> previous;
   for (std::size_t i = 0; i < n; ++i) {
-    const pipeline::FrameMetrics m = pipeline::measureFrame(reader.readFrame(i));
+    cache::FrameRecord frame = reader.readFrame(i);
+    const pipeline::FrameMetrics m = pipeline::measureFrame(frame);
+    if (previous)
+      row.poppingMax = std::max(row.poppingMax, pipeline::poppingMeasure(*previous, frame));
+    previous = std::move(frame);
     triangles += static_cast<double>(m.triangles);
     cMean += m.cMean;
     nComp += m.nComp;

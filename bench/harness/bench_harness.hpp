@@ -43,8 +43,9 @@ struct BenchRow {
   double defectMean = 0.0, defectMax = 0.0;  // rad (mean over frames of the mean; max)
   double defectTotal = 0.0;                  // rad: mean over frames of the sum over vertices
   double handleErrorMax = 0.0;               // m
-  int singularMax = 0;                       // singular vertices, most in a frame
-  double tearStraightDev = -1.0;             // fraction of the width (tear-straight; < 0: n/a)
+  double poppingMax = 0.0;        // pipeline::poppingMeasure, largest between consecutive frames
+  int singularMax = 0;            // singular vertices, most in a frame
+  double tearStraightDev = -1.0;  // fraction of the width (tear-straight; < 0: n/a)
   double tearHyperbolaMedian = -1.0, tearHyperbolaP90 = -1.0;  // deg (tear-curved; < 0: n/a)
   std::string status = "ok";                                   // or why the run stopped early
   bool ok() const { return status == "ok"; }

@@ -124,7 +124,7 @@ void writeBenchCsv(const std::string& path, const std::vector<BenchRow>& rows) {
                                   : s);
   out << ",ms_total,newton_per_substep,c_mean_mean_pct,c_mean_max_pct,n_comp_mean_pct,"
          "n_comp_max_pct,angle_defect_mean_rad,angle_defect_max_rad,angle_defect_total_rad,"
-         "handle_error_max_m,"
+         "handle_error_max_m,popping_max,"
          "singular_max,tear_straight_dev_pct,tear_hyperbola_median_deg,tear_hyperbola_p90_deg,"
          "status\n";
   const auto optional = [](double v, double scale) {
@@ -139,9 +139,10 @@ void writeBenchCsv(const std::string& path, const std::vector<BenchRow>& rows) {
     out << ',' << num(r.msTotal) << ',' << num(r.newtonPerSubstep) << ',' << num(100 * r.cMeanMean)
         << ',' << num(100 * r.cMeanMax) << ',' << num(100 * r.nCompMean) << ','
         << num(100 * r.nCompMax) << ',' << num(r.defectMean) << ',' << num(r.defectMax) << ','
-        << num(r.defectTotal) << ',' << num(r.handleErrorMax) << ',' << r.singularMax << ','
-        << optional(r.tearStraightDev, 100) << ',' << optional(r.tearHyperbolaMedian, 1) << ','
-        << optional(r.tearHyperbolaP90, 1) << ',' << csvField(r.status) << '\n';
+        << num(r.defectTotal) << ',' << num(r.handleErrorMax) << ',' << num(r.poppingMax) << ','
+        << r.singularMax << ',' << optional(r.tearStraightDev, 100) << ','
+        << optional(r.tearHyperbolaMedian, 1) << ',' << optional(r.tearHyperbolaP90, 1) << ','
+        << csvField(r.status) << '\n';
   }
   if (!out) throw std::runtime_error("cannot write " + path);
 }

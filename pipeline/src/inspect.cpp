@@ -125,6 +125,59 @@ FrameMetrics measureFrame(const cache::FrameRecord& frame) {
   return m;
 }
 
+SheetMoments sheetMoments(const std::vector<std::array<int, 3>>& triangles,
+                          const std::vector<Vec2>& pattern, const std::vector<Vec3>& positions) {
+  // Per triangle: its pattern area A, centroid g and, for a uniform density
+  // over it, the mean of |x - g|^2, (|a - g|^2 + |b - g|^2 + |c - g|^2) / 12.
+  std::vector<double> areas;
+  std::vector<Vec3> centroids;
+  areas.reserve(triangles.size());
+  centroids.reserve(triangles.size());
+  double area = 0.0;
+  Vec3 first = Vec3::Zero();
+  for (const auto& t : triangles) {
+    const Vec2 u =
+        pattern[static_cast<std::size_t>(t[1])] - pattern[static_cast<std::size_t>(t[0])];
+    const Vec2 v =
+        pattern[static_cast<std::size_t>(t[2])] - pattern[static_cast<std::size_t>(t[0])];
+    const double a = 0.5 * std::abs(u.x() * v.y() - u.y() * v.x());
+    const Vec3 g =
+        (positions[static_cast<std::size_t>(t[0])] + positions[static_cast<std::size_t>(t[1])] +
+         positions[static_cast<std::size_t>(t[2])]) /
+        3.0;
+    areas.push_back(a);
+    centroids.push_back(g);
+    area += a;
+    first += a * g;
+  }
+  SheetMoments m;
+  if (!(area > 0.0)) return m;
+  m.centroid = first / area;
+  // Two passes: distances to the centroid, not a difference of large squares.
+  double second = 0.0;
+  for (std::size_t k = 0; k < triangles.size(); ++k) {
+    const Vec3& g = centroids[k];
+    double spread = 0.0;
+    for (const int v : triangles[k])
+      spread += (positions[static_cast<std::size_t>(v)] - g).squaredNorm();
+    second += areas[k] * ((g - m.centroid).squaredNorm() + spread / 12.0);
+  }
+  m.gyration = std::sqrt(second / area);
+  return m;
+}
+
+double poppingMeasure(const cache::FrameRecord& previous, const cache::FrameRecord& current) {
+  const SheetMoments a = sheetMoments(previous.triangles, previous.pattern, previous.positions);
+  const SheetMoments b = sheetMoments(current.triangles, current.pattern, current.positions);
+  double handleMove = 0.0;
+  const std::size_t handles = std::min(previous.handleTargets.size(), current.handleTargets.size());
+  for (std::size_t h = 0; h < handles; ++h)
+    handleMove =
+        std::max(handleMove, (current.handleTargets[h] - previous.handleTargets[h]).norm());
+  const double jump = std::max((b.centroid - a.centroid).norm(), std::abs(b.gyration - a.gyration));
+  return jump / (3.0 * (handleMove + 1e-3));
+}
+
 namespace {
 
 // Decoding errors name the cache file.
@@ -166,9 +219,11 @@ std::string inspectJson(const cache::CacheReader& reader) {
     j.endArray();
   }
   j.key("frames").beginArray();
+  std::optional<cache::FrameRecord> previous;
   for (std::size_t i = 0; i < reader.frameCount(); ++i) {
-    const auto frame = reader.readFrame(i);
-    const auto m = measure(reader, frame);
+    auto frame = reader.readFrame(i);
+    auto m = measure(reader, frame);
+    if (previous) m.popping = poppingMeasure(*previous, frame);
     j.beginObject();
     j.key("frame").value(m.frame);
     j.key("time").value(m.time);
@@ -200,7 +255,9 @@ std::string inspectJson(const cache::CacheReader& reader) {
     j.key("angle_defect_max").value(m.maxAngleDefect);
     j.key("angle_defect_total").value(m.totalAngleDefect);
     j.key("angle_defect_vertices").value(m.defectVertices);
+    j.key("popping").value(m.popping);
     j.endObject();
+    previous = std::move(frame);
   }
   j.endArray();
   j.endObject();
@@ -227,12 +284,17 @@ std::string inspectText(const cache::CacheReader& reader) {
   }
   std::vector<FrameMetrics> metrics;
   bool torn = false;  // a tears column when any frame has a tear
+  std::optional<cache::FrameRecord> previous;
   for (std::size_t i = 0; i < reader.frameCount(); ++i) {
-    metrics.push_back(measure(reader, reader.readFrame(i)));
+    cache::FrameRecord frame = reader.readFrame(i);
+    metrics.push_back(measure(reader, frame));
+    if (previous) metrics.back().popping = poppingMeasure(*previous, frame);
     torn = torn || metrics.back().tears > 0;
+    previous = std::move(frame);
   }
-  std::snprintf(line, sizeof line, "%6s %9s %8s %9s %10s %8s %10s %9s %12s", "frame", "time[s]",
-                "verts", "tris", "c_mean", "n_comp", "max_strain", "dihedral", "handle_err[m]");
+  std::snprintf(line, sizeof line, "%6s %9s %8s %9s %10s %8s %10s %9s %12s %8s", "frame", "time[s]",
+                "verts", "tris", "c_mean", "n_comp", "max_strain", "dihedral", "handle_err[m]",
+                "popping");
   out += line;
   if (colliders) {
     std::snprintf(line, sizeof line, " %8s %14s", "contacts", "max_slide[m/s]");
@@ -241,9 +303,9 @@ std::string inspectText(const cache::CacheReader& reader) {
   if (torn) out += "  tears";
   out += "\n";
   for (const FrameMetrics& m : metrics) {
-    std::snprintf(line, sizeof line, "%6d %9.4f %8zu %9zu %10.3e %8.4f %10.3e %9.4f %12.3e",
+    std::snprintf(line, sizeof line, "%6d %9.4f %8zu %9zu %10.3e %8.4f %10.3e %9.4f %12.3e %8.3f",
                   m.frame, m.time, m.vertices, m.triangles, m.cMean, m.nComp, m.maxStrain,
-                  m.maxDihedral, m.handleError);
+                  m.maxDihedral, m.handleError, m.popping);
     out += line;
     if (colliders) {
       std::snprintf(line, sizeof line, " %8zu %14.3e", m.contacts, m.maxSlideSpeed);

@@ -385,7 +385,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   compare->add_option("--diff", a.diff, "diff image path (default: B's folder, <B>.diff.png)");
   auto* inspect = app.add_subcommand(
-      "inspect", "Print per-frame sizes, strain, sharpest fold and handle error of a cache.");
+      "inspect",
+      "Print per-frame sizes, strain, sharpest fold, handle error and popping (the sheet's jump "
+      "against its handles' motion, docs/CRUMPLING.md) of a cache.");
   inspect->add_option("CACHE", a.cache, "a .pcache file")->required();
   inspect->add_flag("--json", a.json, "one JSON object for scripts");
   auto* exportCmd = app.add_subcommand(

@@ -148,9 +148,10 @@ TEST(BenchCommand, QuickWritesTheCsvThePlotAndTheReport) {
   std::string header, line;
   std::getline(csv, header);
   EXPECT_EQ(header.rfind("sample,role,model,edge_cm,substeps", 0), 0u) << header;
-  for (const char* column : {"ms_total", "c_mean_mean_pct", "n_comp_max_pct",
-                             "angle_defect_mean_rad", "angle_defect_max_rad", "handle_error_max_m",
-                             "tear_straight_dev_pct", "tear_hyperbola_median_deg", "status"})
+  for (const char* column :
+       {"ms_total", "c_mean_mean_pct", "n_comp_max_pct", "angle_defect_mean_rad",
+        "angle_defect_max_rad", "handle_error_max_m", "popping_max", "tear_straight_dev_pct",
+        "tear_hyperbola_median_deg", "status"})
     EXPECT_NE(header.find(column), std::string::npos) << column;
   EXPECT_EQ(header.rfind("sample,role,model,edge_cm,substeps,length_sweeps", 0), 0u) << header;
   int hybrid = 0, elastic = 0, sweeps = 0;

@@ -77,13 +77,14 @@ TEST(Cli, InspectJsonHasTheDocumentedKeys) {
        {"\"format_version\"", "\"fps\"", "\"frame_count\":6", "\"frames\"", "\"frame\"", "\"time\"",
         "\"vertices\"", "\"triangles\"", "\"c_mean\"", "\"n_comp\"", "\"max_strain\"",
         "\"max_dihedral\"", "\"handle_error\"", "\"handles\"", "\"name\":\"left\"", "\"position\"",
-        "\"singular_vertices\":0", "\"junction_vertices\":0", "\"tears\":0"})
+        "\"singular_vertices\":0", "\"junction_vertices\":0", "\"tears\":0", "\"popping\""})
     EXPECT_NE(r.output.find(key), std::string::npos) << key;
   EXPECT_EQ(r.output.front(), '{');
   const auto text = runCrumple("inspect " + (tmp / "out/cache.pcache").string());
   EXPECT_EQ(text.status, 0);
   EXPECT_NE(text.output.find("c_mean"), std::string::npos);
   EXPECT_NE(text.output.find("dihedral"), std::string::npos);
+  EXPECT_NE(text.output.find("popping"), std::string::npos);
 }
 
 TEST(Cli, RenderAFrameRangeFromTheCacheAlone) {

@@ -33,6 +33,7 @@ struct FrameMetrics {
   double maxAngleDefect = 0.0;     // max |defect| over them
   double totalAngleDefect = 0.0;   // sum of |defect| (discrete total |K| dA, resolution-free)
   std::size_t defectVertices = 0;  // how many were measured
+  double popping = 0.0;            // poppingMeasure against the frame before (0 on the first)
 };
 
 // The angle defect of a triangle mesh (Gauss-Bonnet's discrete curvature):
@@ -50,6 +51,25 @@ AngleDefect angleDefect(const std::vector<std::array<int, 3>>& triangles,
 
 // Throws CorruptDataError naming the frame for a malformed CONT block.
 FrameMetrics measureFrame(const cache::FrameRecord& frame);
+
+// The sheet's mass distribution: the centroid and radius of gyration of its
+// surface, each triangle weighted by its pattern (material) area, uniform
+// over the triangle: unchanged when the same surface is triangulated
+// anew.
+struct SheetMoments {
+  Vec3 centroid = Vec3::Zero();  // m
+  double gyration = 0.0;         // m, sqrt of the mean squared distance to the centroid
+};
+SheetMoments sheetMoments(const std::vector<std::array<int, 3>>& triangles,
+                          const std::vector<Vec2>& pattern, const std::vector<Vec3>& positions);
+
+// The popping measure between two consecutive frames: the change of the
+// sheet's centroid and of its radius of gyration (the larger), over 3 x
+// (the largest displacement of a handle's track between them + 1 mm).
+// Above 1 the sheet jumped more than its handles moved it: a pop when S_P's
+// connectivity changed (paper Sec. 7.4, limitation 3). Handles are matched
+// by index; a frame pair with different handle counts uses the common ones.
+double poppingMeasure(const cache::FrameRecord& previous, const cache::FrameRecord& current);
 // The cached frame as a sheet mesh (pattern, positions, triangles, regions),
 // e.g. for mesh::validate.
 mesh::SheetMesh sheetOfFrame(const cache::FrameRecord& frame);
@@ -59,7 +79,8 @@ mesh::SheetMesh sheetOfFrame(const cache::FrameRecord& frame);
 // cache whose header has COLL adds "colliders": [{"name", "material",
 // "friction"}] and, per frame, "contacts" and "max_slide_speed" (m/s).
 // Every frame has "angle_defect_mean", "angle_defect_max",
-// "angle_defect_total" (rad) and "angle_defect_vertices" (FrameMetrics).
+// "angle_defect_total" (rad), "angle_defect_vertices" and "popping"
+// (FrameMetrics).
 std::string inspectJson(const cache::CacheReader& reader);
 // The human-readable table (with the colliders and a contacts and a max
 // slide speed column when the header has COLL).
