@@ -16,7 +16,7 @@
 namespace crumple::pipeline {
 namespace {
 
-constexpr std::uint32_t kCheckpointVersion = 1;
+constexpr std::uint32_t kCheckpointVersion = 2;
 constexpr char kMagic[9] = "CRUMPCKP";
 
 std::uint32_t sceneHash(const io::SceneSpec& scene) {
@@ -113,6 +113,12 @@ void saveReport(StateWriter& w, const ShotReport& r) {
   w.i64(r.substeps);
   w.i64(r.halvings);
   w.i64(r.elasticRetries);
+  w.i64(r.strainLimitRuns);
+  w.i64(r.strainLimitCarried);
+  w.i32(r.lagFrames);
+  w.f64(r.maxHandleLag);
+  w.i32(r.maxHandleLagFrame);
+  w.i32(r.maxHandleLagVertex);
   w.f64(r.contactMs);
   w.f64(r.selfContactMs);
   w.i64(r.selfContactSteps);
@@ -142,6 +148,12 @@ void restoreReport(StateReader& in, ShotReport& r) {
   r.substeps = in.i64();
   r.halvings = in.i64();
   r.elasticRetries = in.i64();
+  r.strainLimitRuns = in.i64();
+  r.strainLimitCarried = in.i64();
+  r.lagFrames = in.i32();
+  r.maxHandleLag = in.f64();
+  r.maxHandleLagFrame = in.i32();
+  r.maxHandleLagVertex = in.i32();
   r.contactMs = in.f64();
   r.selfContactMs = in.f64();
   r.selfContactSteps = in.i64();

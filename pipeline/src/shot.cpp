@@ -121,6 +121,8 @@ void finishFrames(const std::string& framesDir, const FrameRange& range, double 
 // Above this mean edge-length error (c_mean) a hybrid shot warns: the
 // model's target is 0.5 % (issue 3; paper Table IV reaches 0.17-1.47 %).
 constexpr double kLengthErrorWarning = 0.01;
+// A handle further than this from its node lags (strain_limit.hpp).
+constexpr double kLagReported = 1e-6;
 
 paper::CrumpleParams crumpleParamsOf(const io::HybridSpec& h) {
   paper::CrumpleParams p;
@@ -139,6 +141,7 @@ paper::CrumpleParams crumpleParamsOf(const io::HybridSpec& h) {
   p.isometryLengthTolerance = h.isometryLengthTolerance;
   p.maxSingularPerFrame = h.maxSingularPerFrame;
   p.remeshCooldown = h.remeshCooldown;
+  p.maxEdgeStrain = h.maxEdgeStrain;
   // Region invariants after every geometric step: always in debug builds,
   // on request (CRUMPLE_CHECK_INVARIANTS=1) in release builds.
   if (const char* env = std::getenv("CRUMPLE_CHECK_INVARIANTS"); env != nullptr && env[0] == '1')
@@ -590,6 +593,18 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
           "the elastic solve failed with self-contact and went on without it at frames " +
           std::to_string(selfContactDropped.first) + "-" +
           std::to_string(selfContactDropped.second) + ": the sheet may pass through itself there");
+    if (report.lagFrames > 0) {
+      std::string who = "a handle";
+      for (const auto& h : rig.handles())
+        if (h.vertex == report.maxHandleLagVertex) who = "handle '" + h.name + "'";
+      char text[320];
+      std::snprintf(text, sizeof text,
+                    "%s lags behind its node on %d frames, up to %.3g mm at frame %d: the sheet "
+                    "cannot follow there without stretching over [model] max_edge_strain",
+                    who.c_str(), report.lagFrames, 1e3 * report.maxHandleLag,
+                    report.maxHandleLagFrame);
+      report.warnings.push_back(text);
+    }
     for (const auto& [h, span] : beyondReach) {
       char text[320];
       std::snprintf(text, sizeof text,
@@ -1044,6 +1059,14 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
         report.halvings += stats.elastic.halvings;
         noteRecovery(stats.elastic, frame);
         report.elasticRetries += stats.elasticRetries;
+        report.strainLimitRuns += stats.strainLimitRuns;
+        report.strainLimitCarried += stats.strainLimitCarried;
+        if (stats.strainLimit.lag > kLagReported) ++report.lagFrames;
+        if (stats.strainLimit.lag > report.maxHandleLag) {
+          report.maxHandleLag = stats.strainLimit.lag;
+          report.maxHandleLagFrame = frame;
+          report.maxHandleLagVertex = stats.strainLimit.lagVertex;
+        }
         report.substeps += scene.substeps;
         report.contactMs += stats.elastic.contactMs + stats.ms.contacts;
         report.selfContactMs += stats.elastic.selfContactMs + stats.ms.selfContacts;
@@ -1054,6 +1077,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
             {"cones", stats.ms.cones},
             {"rebuild", stats.ms.rebuild},
             {"isometry", stats.ms.isometry},
+            {"strain limit", stats.ms.strainLimit},
             {"contacts", stats.ms.contacts + stats.ms.selfContacts}};
         for (const auto& [name, ms] : stages) {
           if (!contactsOn && std::string_view(name) == "contacts") continue;
@@ -1365,6 +1389,13 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
     j.key("interior_singular_vertices").value(r.interiorSingularVertices);
     j.key("max_triangles").value(static_cast<long long>(r.maxTriangles));
     j.key("elastic_retries").value(static_cast<long long>(r.elasticRetries));
+    j.key("strain_limit_steps").value(static_cast<long long>(r.strainLimitRuns));
+    j.key("strain_limit_carried_steps").value(static_cast<long long>(r.strainLimitCarried));
+    // Handles held back so the sheet does not stretch (strain_limit.hpp).
+    j.key("handle_lag_frames").value(static_cast<long long>(r.lagFrames));
+    j.key("max_handle_lag").value(r.maxHandleLag);
+    j.key("max_handle_lag_frame").value(static_cast<long long>(r.maxHandleLagFrame));
+    j.key("max_handle_lag_vertex").value(static_cast<long long>(r.maxHandleLagVertex));
     j.endObject();
   }
   j.key("warnings").beginArray();

@@ -500,7 +500,8 @@ TEST(SceneModel, EveryKeyParsedAndConvertedToSI) {
       "isometry_length_sweeps = 0\n"
       "isometry_length_tolerance = 1e-9\n"
       "max_singular_per_frame = 5\n"
-      "remesh_cooldown = 0\n");
+      "remesh_cooldown = 0\n"
+      "max_edge_strain = 0.02\n");
   const HybridSpec& h = s.model.hybrid;
   EXPECT_EQ(s.model.type, ModelSpec::Type::Hybrid);
   EXPECT_DOUBLE_EQ(h.rhoBound, 250.0);
@@ -518,6 +519,7 @@ TEST(SceneModel, EveryKeyParsedAndConvertedToSI) {
   EXPECT_DOUBLE_EQ(h.isometryLengthTolerance, 1e-9);
   EXPECT_EQ(h.maxSingularPerFrame, 5);
   EXPECT_EQ(h.remeshCooldown, 0);
+  EXPECT_DOUBLE_EQ(h.maxEdgeStrain, 0.02);
 }
 
 TEST(SceneModel, HysteresisFollowsTheta0) {
@@ -576,6 +578,9 @@ TEST(SceneErrors, Model) {
   expectError(head + "eps_c = -0.001\n", 6, "model.eps_c", {"(0, 0.5)"});
   expectError(head + "sigma_cm = 0\n", 6, "model.sigma_cm", {"(0, 100)"});
   expectError(head + "sigma_cm = inf\n", 6, "model.sigma_cm", {"finite"});
+  expectError(head + "max_edge_strain = -0.01\n", 6, "model.max_edge_strain", {"[0, 0.5)"});
+  expectError(head + "max_edge_strain = 2\n", 6, "model.max_edge_strain", {"[0, 0.5)", "got 2"});
+  expectError(head + "max_edge_strain = nan\n", 6, "model.max_edge_strain", {"finite"});
   expectError(head + "theta_rest = -0.1\n", 6, "model.theta_rest", {"[0, pi)"});
   expectError(head + "theta_rest = 3.2\n", 6, "model.theta_rest", {"[0, pi)"});
   expectError(head + "damage = -1\n", 6, "model.damage", {">= 0"});

@@ -325,6 +325,7 @@ TEST(CrumplingSamples, SceneDefaultsAreTheModelsDefaults) {
   EXPECT_EQ(h.isometryLengthTolerance, p.isometryLengthTolerance);
   EXPECT_EQ(h.maxSingularPerFrame, p.maxSingularPerFrame);
   EXPECT_EQ(h.remeshCooldown, p.remeshCooldown);
+  EXPECT_EQ(h.maxEdgeStrain, p.maxEdgeStrain);
 }
 
 // `[model] isometry_length_sweeps` reaches the isometry projection and buys

@@ -874,7 +874,8 @@ class SceneParser {
                                                        "isometry_length_sweeps",
                                                        "isometry_length_tolerance",
                                                        "max_singular_per_frame",
-                                                       "remesh_cooldown"};
+                                                       "remesh_cooldown",
+                                                       "max_edge_strain"};
     std::vector<std::string_view> allowed = {"type"};
     allowed.insert(allowed.end(), std::begin(kHybridKeys), std::end(kHybridKeys));
     r.allowOnly(allowed);
@@ -981,6 +982,10 @@ class SceneParser {
     };
     if (auto n = count("max_singular_per_frame", 1000)) h.maxSingularPerFrame = *n;
     if (auto n = count("remesh_cooldown", 1000)) h.remeshCooldown = *n;
+    // Paper stays paper: S_P's edge-strain bound after every animation step
+    // (0 turns the strain limit off).
+    if (auto v = r.number("max_edge_strain"))
+      h.maxEdgeStrain = inRange("max_edge_strain", *v, 0.0, 0.5, true);
   }
 
   std::string file_;

@@ -66,6 +66,18 @@ void accumulate(HybridStepStats& total, const HybridStepStats& s) {
   total.ms.isometry += s.ms.isometry;
   total.ms.contacts += s.ms.contacts;
   total.ms.selfContacts += s.ms.selfContacts;
+  total.ms.strainLimit += s.ms.strainLimit;
+  {
+    const StrainLimitStats before = total.strainLimit;
+    total.strainLimit = s.strainLimit;
+    total.strainLimit.iterations += before.iterations;
+    if (before.lag > s.strainLimit.lag) {
+      total.strainLimit.lag = before.lag;
+      total.strainLimit.lagVertex = before.lagVertex;
+    }
+    total.strainLimitRuns += s.strainLimit.ran ? 1 : 0;
+    total.strainLimitCarried += s.strainLimit.carried ? 1 : 0;
+  }
   total.elastic.contactMs += s.elastic.contactMs;
   total.elastic.selfContactMs += s.elastic.selfContactMs;
   total.elastic.selfContactSteps += s.elastic.selfContactSteps;
@@ -160,6 +172,9 @@ struct HybridSheet::Impl {
       traceHinge[static_cast<std::size_t>(stage)] = detail::maxHingeAngle(*elastic);
   }
 
+  void limitStepStrain(const mesh::SheetMesh& spBefore, const GeometricMesh& sgBefore,
+                       const std::vector<sim::Pin>& pinned, int frame, std::vector<Vec3>& positions,
+                       HybridStepStats& stats);
   void animationStep(double t, double dt, const sim::PinFunction& pins, int frame,
                      int singularBudget, std::uint64_t& draw, HybridStepStats& stats,
                      const char*& stage);
@@ -471,10 +486,68 @@ int HybridSheet::interiorSingularVertexCount() const {
 // t + dt: an elastic step of S_P, S_P -> S_G, the geometric step, cone
 // fitting, S_P rebuilt from S_G and the isometry projection. `stage` names
 // the stage running, for the error message when it throws.
+// Paper stays paper after the isometry (strain_limit.hpp): S_P within
+// maxEdgeStrain, the handles on their targets or lagging; a remeshing that
+// leaves no configuration within the bound is undone.
+void HybridSheet::Impl::limitStepStrain(const mesh::SheetMesh& spBefore,
+                                        const GeometricMesh& sgBefore,
+                                        const std::vector<sim::Pin>& pinned, int frame,
+                                        std::vector<Vec3>& positions, HybridStepStats& stats) {
+  Impl& m = *this;
+  // The handle vertices and their targets (tangent-plane pins bind in the
+  // elastic step only).
+  std::vector<int> handles, tangentPins;
+  std::vector<Vec3> targets;
+  for (const sim::Pin& p : pinned) {
+    const auto v = static_cast<std::size_t>(p.vertex);
+    if (v < positions.size() && (v >= m.sg.vertices.size() || !m.sg.vertices[v].handle))
+      tangentPins.push_back(p.vertex);
+    if (v >= m.sg.vertices.size() || !m.sg.vertices[v].handle || v >= spBefore.positions.size())
+      continue;
+    handles.push_back(p.vertex);
+    targets.push_back(p.position);
+  }
+  const auto limit = [&] {
+    const bool sameMesh =
+        spBefore.triangles == m.sp.mesh.triangles && spBefore.pattern == m.sp.mesh.pattern;
+    return limitStrain({m.sp.mesh.pattern, m.sp.mesh.triangles, spBefore.pattern,
+                        spBefore.triangles, spBefore.positions, sameMesh, handles, targets,
+                        tangentPins, m.params.maxEdgeStrain, m.params.strainLimitIterations},
+                       positions);
+  };
+  stats.strainLimit = limit();
+  if (stats.strainLimit.maxAfter > m.params.maxEdgeStrain && stats.topologyChanged &&
+      spBefore.positions.size() >= m.sg.vertices.size()) {
+    // The new structure leaves S_P no configuration within the bound from
+    // any start, while the step's start was within it: the step's remeshing
+    // is undone (transactional, like the cone fits above) and the sheet as
+    // it was lags instead; the cooldown keeps the region from being remeshed
+    // again at once.
+    m.sg = sgBefore;
+    m.rebuildPhysical();
+    if (m.sp.mesh.triangles == spBefore.triangles && m.sp.mesh.pattern == spBefore.pattern) {
+      positions = spBefore.positions;
+      for (std::size_t h = 0; h < handles.size(); ++h)
+        positions[static_cast<std::size_t>(handles[h])] = targets[h];
+      const int iterations = stats.strainLimit.iterations;
+      stats.strainLimit = limit();
+      stats.strainLimit.iterations += iterations;
+      stats.geometric.notes.push_back(
+          "the step's remeshing undone: S_P had no configuration "
+          "within max_edge_strain");
+    }
+  }
+  if (!allFinite(positions)) throw NumericalError("strain limit", frame, "non-finite positions");
+}
+
 void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunction& pins, int frame,
                                       int singularBudget, std::uint64_t& draw,
                                       HybridStepStats& stats, const char*& stage) {
   Impl& m = *this;
+  // The step's start, for the strain limit's carried start and for undoing
+  // a structure change it cannot bound.
+  const mesh::SheetMesh spBefore = m.sp.mesh;
+  const GeometricMesh sgBefore = m.params.maxEdgeStrain > 0.0 ? m.sg : GeometricMesh{};
   CrumpleParams stepParams = m.params;
   stepParams.maxSingularPerFrame = singularBudget;
   // (a)-(b) elastic relaxation of S_P with the handles as hard constraints.
@@ -638,6 +711,12 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
     stats.isometry.meanDisplacement = 0.0;
   }
   stats.ms.isometry = msSince(t0);
+  if (m.params.maxEdgeStrain > 0.0) {
+    stage = "strain limit";
+    t0 = Clock::now();
+    m.limitStepStrain(spBefore, sgBefore, pinned, frame, positions, stats);
+    stats.ms.strainLimit = msSince(t0);
+  }
   if (m.contactsOn()) {
     stage = "contacts";
     std::vector<char> held(m.sp.mesh.vertexCount(), 0);

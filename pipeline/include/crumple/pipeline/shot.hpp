@@ -84,6 +84,15 @@ struct ShotReport {
   long substeps = 0;
   long halvings = 0;
   long elasticRetries = 0;  // hybrid: elastic steps retried with the pins on their targets
+  // Hybrid strain limit (paper/strain_limit.hpp): animation steps it had
+  // work in, and in how many the carried start or the handle lag gave the
+  // result; frames whose handles lag (over 1 um) and the largest lag.
+  long strainLimitRuns = 0;
+  long strainLimitCarried = 0;
+  int lagFrames = 0;
+  double maxHandleLag = 0.0;  // metres
+  int maxHandleLagFrame = -1;
+  int maxHandleLagVertex = -1;
   // Contacts (issue 5): collider and self-contact work (detection, the
   // failsafe; within the elastic stage, plus the crumpling model's failsafe
   // after its isometry), the deepest free vertex inside a collider or the

@@ -16,6 +16,7 @@
 #include "crumple/paper/geometric_step.hpp"
 #include "crumple/paper/isometry.hpp"
 #include "crumple/paper/params.hpp"
+#include "crumple/paper/strain_limit.hpp"
 #include "crumple/paper/tear_remesh.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
 
@@ -32,6 +33,7 @@ struct HybridStageTimes {
   // and self-contact (with carrying the contact set over to S_P).
   double contacts = 0.0;
   double selfContacts = 0.0;
+  double strainLimit = 0.0;  // strain_limit.hpp, after the contacts
 };
 
 struct HybridStepStats {
@@ -42,6 +44,10 @@ struct HybridStepStats {
   int coneSegments = 0;
   bool topologyChanged = false;  // S_P was rebuilt with a new connectivity
   int elasticRetries = 0;        // elastic steps retried with the pins snapped onto their targets
+  // The strain limit of the frame's last animation step, except: `ran`,
+  // `carried` and `iterations` count the steps, `lag` is the frame's largest.
+  StrainLimitStats strainLimit;
+  int strainLimitRuns = 0, strainLimitCarried = 0;
 };
 
 // What the isometry projection (paper Sec. 6.3) is handed in one animation

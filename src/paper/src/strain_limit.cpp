@@ -1,0 +1,369 @@
+// Strain limiting of S_P: Levenberg-Marquardt length projection, the rigid
+// carried start (Kabsch 1976) and the transfer of positions by pattern
+// (strain_limit.hpp).
+#include "crumple/paper/strain_limit.hpp"
+
+#include <Eigen/SVD>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <tuple>
+#include <utility>
+
+namespace crumple::paper {
+
+namespace {
+
+std::size_t at(int i) { return static_cast<std::size_t>(i); }
+
+}  // namespace
+
+LengthProjector::LengthProjector(const std::vector<Vec2>& pattern,
+                                 const std::vector<std::array<int, 3>>& triangles)
+    : vertexCount_(pattern.size()) {
+  std::map<std::pair<int, int>, int> seen;
+  std::vector<char> used(pattern.size(), 0);
+  for (const auto& t : triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[at(k)], b = t[at((k + 1) % 3)];
+      used[at(a)] = 1;
+      const auto key = std::make_pair(std::min(a, b), std::max(a, b));
+      if (!seen.emplace(key, 0).second) continue;
+      const double rest = (pattern[at(a)] - pattern[at(b)]).norm();
+      if (!(rest > 0.0)) continue;  // a degenerate pattern edge has no strain
+      edges_.push_back({key.first, key.second});
+      rest_.push_back(rest);
+    }
+  for (std::size_t v = 0; v < used.size(); ++v)
+    if (used[v] != 0) used_.push_back(static_cast<int>(v));
+}
+
+std::pair<double, double> LengthProjector::strain(const std::vector<Vec3>& x) const {
+  double mx = 0.0, sum = 0.0;
+  for (std::size_t k = 0; k < edges_.size(); ++k) {
+    const double l = (x[at(edges_[k][1])] - x[at(edges_[k][0])]).norm();
+    const double r = std::abs(l - rest_[k]) / rest_[k];
+    mx = std::max(mx, r);
+    sum += r;
+  }
+  return {mx, edges_.empty() ? 0.0 : sum / static_cast<double>(edges_.size())};
+}
+
+LengthProjectionStats LengthProjector::project(std::vector<Vec3>& x, const std::vector<char>& held,
+                                               double target, int maxIterations) const {
+  LengthProjectionStats stats;
+  std::tie(stats.maxBefore, stats.meanBefore) = strain(x);
+  stats.maxAfter = stats.maxBefore;
+  stats.meanAfter = stats.meanBefore;
+  if (stats.maxBefore <= target || maxIterations <= 0) return stats;
+  std::vector<int> column(vertexCount_, -1);
+  int free = 0;
+  for (int v : used_)
+    if (at(v) >= held.size() || held[at(v)] == 0) column[at(v)] = free++;
+  if (free == 0) return stats;
+  const auto cost = [&](const std::vector<Vec3>& p) {
+    double s = 0.0;
+    for (std::size_t k = 0; k < edges_.size(); ++k) {
+      const double r = ((p[at(edges_[k][1])] - p[at(edges_[k][0])]).norm() - rest_[k]) / rest_[k];
+      s += r * r;
+    }
+    return s;
+  };
+  const Eigen::Index n = 3 * static_cast<Eigen::Index>(free);
+  // Gauss-Newton matrix J^T J and gradient J^T r; J's rows d r_e / d x are
+  // -u, +u on the edge's ends with u = d / (l L).
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(edges_.size() * 36 + static_cast<std::size_t>(n));
+  Eigen::SparseMatrix<double> H(n, n);
+  Eigen::VectorXd g(n);
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+  bool analysed = false;
+  double f = cost(x), mu = 1e-4;
+  // The iterate with the smallest max |r_e|: the objective is the sum of
+  // squares, the bound is on the max.
+  std::vector<Vec3> bestX = x;
+  double bestMax = stats.maxBefore;
+  for (int it = 0; it < maxIterations; ++it) {
+    triplets.clear();
+    g.setZero();
+    for (std::size_t k = 0; k < edges_.size(); ++k) {
+      const auto [a, b] = edges_[k];
+      const Vec3 d = x[at(b)] - x[at(a)];
+      const double l = d.norm();
+      const double r = (l - rest_[k]) / rest_[k];
+      // A collapsed edge has no direction; its zero block keeps the sparsity
+      // pattern the symbolic analysis was made for.
+      const Vec3 u = l > 0.0 ? Vec3(d / (l * rest_[k])) : Vec3::Zero();
+      const std::array<int, 2> cols{column[at(a)], column[at(b)]};
+      const std::array<double, 2> sign{-1.0, 1.0};
+      for (int i = 0; i < 2; ++i) {
+        if (cols[at(i)] < 0) continue;
+        g.segment<3>(3 * cols[at(i)]) += sign[at(i)] * r * u;
+        for (int j = 0; j < 2; ++j) {
+          if (cols[at(j)] < 0) continue;
+          const Mat3 block = sign[at(i)] * sign[at(j)] * u * u.transpose();
+          for (int p = 0; p < 3; ++p)
+            for (int q = 0; q < 3; ++q)
+              triplets.emplace_back(3 * cols[at(i)] + p, 3 * cols[at(j)] + q, block(p, q));
+        }
+      }
+    }
+    // The diagonal always in the pattern, so one symbolic analysis serves.
+    for (Eigen::Index i = 0; i < n; ++i) triplets.emplace_back(i, i, 0.0);
+    H.setFromTriplets(triplets.begin(), triplets.end());
+    const Eigen::VectorXd diag = H.diagonal();
+    const double floor = 1e-9 * std::max(1e-300, diag.maxCoeff());
+    bool accepted = false;
+    for (int tries = 0; tries < 12 && !accepted; ++tries) {
+      Eigen::SparseMatrix<double> A = H;
+      for (Eigen::Index i = 0; i < n; ++i) A.coeffRef(i, i) += mu * (diag(i) + floor);
+      if (!analysed) {
+        ldlt.analyzePattern(A);
+        analysed = true;
+      }
+      ldlt.factorize(A);
+      if (ldlt.info() != Eigen::Success) {
+        mu *= 10.0;
+        continue;
+      }
+      const Eigen::VectorXd step = ldlt.solve(-g);
+      if (!step.allFinite()) {
+        mu *= 10.0;
+        continue;
+      }
+      std::vector<Vec3> trial = x;
+      for (int v : used_)
+        if (const int c = column[at(v)]; c >= 0) trial[at(v)] += step.segment<3>(3 * c);
+      const double ft = cost(trial);
+      if (ft < f) {
+        const double gain = f - ft;
+        x = std::move(trial);
+        f = ft;
+        mu = std::max(1e-12, mu / 3.0);
+        accepted = true;
+        ++stats.iterations;
+        if (gain < 1e-6 * f) it = maxIterations;  // converged: the last gain is negligible
+      } else {
+        mu *= 4.0;
+      }
+    }
+    if (!accepted) break;
+    const double mx = strain(x).first;
+    if (mx < bestMax) {
+      bestMax = mx;
+      bestX = x;
+    }
+    if (mx <= target) break;
+  }
+  x = std::move(bestX);
+  std::tie(stats.maxAfter, stats.meanAfter) = strain(x);
+  return stats;
+}
+
+void LengthProjector::holdAwayFrom(const std::vector<Vec3>& x, double above, int rings,
+                                   std::vector<char>& held) const {
+  std::vector<char> near(vertexCount_, 0);
+  for (std::size_t k = 0; k < edges_.size(); ++k) {
+    const double l = (x[at(edges_[k][1])] - x[at(edges_[k][0])]).norm();
+    if (std::abs(l - rest_[k]) > above * rest_[k])
+      near[at(edges_[k][0])] = near[at(edges_[k][1])] = 1;
+  }
+  for (int ring = 0; ring < rings; ++ring) {
+    std::vector<char> grown = near;
+    for (const auto& e : edges_)
+      if (near[at(e[0])] != 0 || near[at(e[1])] != 0) grown[at(e[0])] = grown[at(e[1])] = 1;
+    near = std::move(grown);
+  }
+  held.resize(vertexCount_, 0);
+  for (std::size_t v = 0; v < vertexCount_; ++v)
+    if (near[v] == 0) held[v] = 1;
+}
+
+RigidMotion fitRigidMotion(const std::vector<Vec3>& from, const std::vector<Vec3>& to) {
+  RigidMotion m;
+  const std::size_t n = std::min(from.size(), to.size());
+  if (n == 0) return m;
+  Vec3 ca = Vec3::Zero(), cb = Vec3::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    ca += from[i];
+    cb += to[i];
+  }
+  ca /= static_cast<double>(n);
+  cb /= static_cast<double>(n);
+  Mat3 cov = Mat3::Zero();
+  double spread = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    cov += (to[i] - cb) * (from[i] - ca).transpose();
+    spread = std::max(spread, (from[i] - ca).norm());
+  }
+  if (n >= 2 && spread > 0.0) {
+    const Eigen::JacobiSVD<Mat3> svd(cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Eigen::Vector3d s = svd.singularValues();
+    if (s(1) > 1e-9 * s(0)) {
+      // Kabsch: R = U diag(1, 1, det(U V^T)) V^T.
+      Mat3 d = Mat3::Identity();
+      d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+      m.rotation = svd.matrixU() * d * svd.matrixV().transpose();
+    } else if (s(0) > 0.0) {
+      // Collinear points: the smallest rotation taking one line onto the other.
+      const Vec3 a = svd.matrixV().col(0), b = svd.matrixU().col(0);
+      m.rotation = Quat::FromTwoVectors(a, b).toRotationMatrix();
+    }
+  }
+  m.translation = cb - m.rotation * ca;
+  return m;
+}
+
+std::vector<Vec3> transferByPattern(const std::vector<Vec2>& oldPattern,
+                                    const std::vector<std::array<int, 3>>& oldTriangles,
+                                    const std::vector<Vec3>& oldPositions,
+                                    const std::vector<Vec2>& pattern) {
+  std::vector<Vec3> out(pattern.size(), Vec3::Zero());
+  for (std::size_t i = 0; i < pattern.size(); ++i) {
+    const Vec2& p = pattern[i];
+    double best = std::numeric_limits<double>::infinity();
+    Vec3 placed = Vec3::Zero();
+    for (const auto& t : oldTriangles) {
+      const Vec2 &a = oldPattern[at(t[0])], &b = oldPattern[at(t[1])], &c = oldPattern[at(t[2])];
+      const Mat2 e = (Mat2() << b - a, c - a).finished();
+      const double det = e.determinant();
+      if (std::abs(det) < 1e-300) continue;
+      const Vec2 uv = e.inverse() * (p - a);
+      const double w0 = 1.0 - uv.x() - uv.y();
+      // Distance outside the triangle in barycentric units; 0 inside.
+      const double outside = std::max({0.0, -w0, -uv.x(), -uv.y()});
+      if (outside >= best) continue;
+      best = outside;
+      // Clamped barycentrics so a point just outside stays on the triangle.
+      Eigen::Vector3d w(std::max(0.0, w0), std::max(0.0, uv.x()), std::max(0.0, uv.y()));
+      w /= std::max(1e-300, w.sum());
+      placed = w(0) * oldPositions[at(t[0])] + w(1) * oldPositions[at(t[1])] +
+               w(2) * oldPositions[at(t[2])];
+      if (outside == 0.0) break;
+    }
+    out[i] = placed;
+  }
+  return out;
+}
+
+namespace {
+
+// The projections aim at half the bound, so the next step does not start at
+// the limit.
+constexpr double kAim = 0.5;
+// The local first attempt frees the vertices this many edges around the
+// edges over the bound.
+constexpr int kLocalRings = 2;
+
+void placeHandles(std::vector<Vec3>& x, const std::vector<int>& handles,
+                  const std::vector<Vec3>& where) {
+  for (std::size_t h = 0; h < handles.size(); ++h) x[at(handles[h])] = where[h];
+}
+
+}  // namespace
+
+StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
+  StrainLimitStats s;
+  const LengthProjector projector(in.pattern, in.triangles);
+  std::tie(s.maxBefore, s.meanAfter) = projector.strain(x);
+  s.maxAfter = s.maxBefore;
+  const auto finish = [&](std::vector<Vec3> chosen) {
+    x = std::move(chosen);
+    std::tie(s.maxAfter, s.meanAfter) = projector.strain(x);
+    for (std::size_t h = 0; h < in.handles.size(); ++h) {
+      const double d = (x[at(in.handles[h])] - in.targets[h]).norm();
+      if (d > s.lag) {
+        s.lag = d;
+        s.lagVertex = in.handles[h];
+      }
+    }
+    return s;
+  };
+  if (s.maxBefore <= in.bound) return finish(x);
+  s.ran = true;
+  const double aim = kAim * in.bound;
+  std::vector<char> held(in.pattern.size(), 0);
+  for (int h : in.handles) held[at(h)] = 1;
+  // 1. The stepped sheet, handles on their targets, first with the pins held
+  // too. The projection lowers sum_e r_e^2, not the max, so the given sheet
+  // stays a candidate.
+  std::vector<Vec3> best = x;
+  double bestMax = s.maxBefore;
+  {
+    std::vector<char> pinHeld = held;
+    for (int v : in.pins)
+      if (static_cast<std::size_t>(v) < pinHeld.size()) pinHeld[at(v)] = 1;
+    projector.holdAwayFrom(x, in.bound, kLocalRings, pinHeld);
+    std::vector<Vec3> pinnedStep = x;
+    placeHandles(pinnedStep, in.handles, in.targets);
+    const auto pinStats = projector.project(pinnedStep, pinHeld, aim, in.iterations);
+    s.iterations += pinStats.iterations;
+    if (pinStats.maxAfter <= in.bound) return finish(std::move(pinnedStep));
+  }
+  std::vector<Vec3> stepped = x;
+  placeHandles(stepped, in.handles, in.targets);
+  auto stats = projector.project(stepped, held, aim, in.iterations);
+  s.iterations += stats.iterations;
+  if (stats.maxAfter < bestMax) {
+    best = std::move(stepped);
+    bestMax = stats.maxAfter;
+  }
+  if (bestMax <= in.bound) return finish(std::move(best));
+  // 2. The carried start: the step's start moved rigidly with the handles.
+  std::vector<Vec3> from;
+  for (int h : in.handles) from.push_back(in.beforePositions[at(h)]);
+  const RigidMotion motion = fitRigidMotion(from, in.targets);
+  std::vector<Vec3> base = in.sameMesh ? in.beforePositions
+                                       : transferByPattern(in.beforePattern, in.beforeTriangles,
+                                                           in.beforePositions, in.pattern);
+  for (Vec3& p : base) p = motion.apply(p);
+  std::vector<Vec3> carried = base;
+  placeHandles(carried, in.handles, in.targets);
+  stats = projector.project(carried, held, aim, in.iterations);
+  s.iterations += stats.iterations;
+  if (stats.maxAfter < bestMax) {
+    best = std::move(carried);
+    bestMax = stats.maxAfter;
+    s.carried = true;
+  }
+  if (bestMax <= in.bound) return finish(std::move(best));
+  // 3. Lag: the handles on the way from their carried positions to their
+  // targets, as far as the bound allows (bisection).
+  std::vector<Vec3> start;
+  for (int h : in.handles) start.push_back(base[at(h)]);
+  std::vector<Vec3> feasible = base;
+  stats = projector.project(feasible, held, aim, in.iterations);
+  s.iterations += stats.iterations;
+  if (stats.maxAfter > in.bound) {
+    // Not even the carried step's start meets the bound: the best attempt.
+    if (stats.maxAfter < bestMax) {
+      best = std::move(feasible);
+      s.carried = true;
+    }
+    return finish(std::move(best));
+  }
+  double lo = 0.0, hi = 1.0;
+  for (int k = 0; k < 5; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    std::vector<Vec3> where(in.handles.size());
+    for (std::size_t h = 0; h < where.size(); ++h)
+      where[h] = start[h] + mid * (in.targets[h] - start[h]);
+    std::vector<Vec3> trial = feasible;
+    placeHandles(trial, in.handles, where);
+    stats = projector.project(trial, held, aim, in.iterations);
+    s.iterations += stats.iterations;
+    if (stats.maxAfter <= in.bound) {
+      lo = mid;
+      feasible = std::move(trial);
+    } else {
+      hi = mid;
+    }
+  }
+  s.carried = true;
+  return finish(std::move(feasible));
+}
+
+}  // namespace crumple::paper

@@ -1,0 +1,266 @@
+// The strain limit of S_P (strain_limit.hpp): the Levenberg-Marquardt length
+// projection, the rigid fit (Kabsch 1976), the transfer by pattern and the
+// whole stage with its carried start and handle lag.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "crumple/paper/strain_limit.hpp"
+
+namespace crumple::paper {
+namespace {
+
+using Tri = std::array<int, 3>;
+
+// An n x m grid of squares (each split in two) over w x h metres.
+struct Grid {
+  std::vector<Vec2> pattern;
+  std::vector<Tri> triangles;
+  int n = 0, m = 0;
+  [[nodiscard]] int at(int i, int j) const { return j * (n + 1) + i; }
+};
+
+Grid makeGrid(int n, int m, double w, double h) {
+  Grid g;
+  g.n = n;
+  g.m = m;
+  for (int j = 0; j <= m; ++j)
+    for (int i = 0; i <= n; ++i) g.pattern.emplace_back(w * i / n, h * j / m);
+  for (int j = 0; j < m; ++j)
+    for (int i = 0; i < n; ++i) {
+      g.triangles.push_back({g.at(i, j), g.at(i + 1, j), g.at(i + 1, j + 1)});
+      g.triangles.push_back({g.at(i, j), g.at(i + 1, j + 1), g.at(i, j + 1)});
+    }
+  return g;
+}
+
+std::vector<Vec3> lift(const std::vector<Vec2>& p) {
+  std::vector<Vec3> x;
+  for (const Vec2& q : p) x.emplace_back(q.x(), q.y(), 0.0);
+  return x;
+}
+
+// Rolled onto a cylinder of radius r about the y axis: an isometry.
+std::vector<Vec3> roll(const std::vector<Vec2>& p, double r) {
+  std::vector<Vec3> x;
+  for (const Vec2& q : p)
+    x.emplace_back(r * std::sin(q.x() / r), q.y(), r - r * std::cos(q.x() / r));
+  return x;
+}
+
+TEST(LengthProjector, MeasuresStrainAgainstThePattern) {
+  const Grid g = makeGrid(4, 3, 0.1, 0.06);
+  const LengthProjector p(g.pattern, g.triangles);
+  EXPECT_EQ(p.edgeCount(), 4u * 4 + 3u * 5 + 4u * 3);
+  std::vector<Vec3> x = lift(g.pattern);
+  EXPECT_NEAR(p.strain(x).first, 0.0, 1e-15);
+  for (Vec3& v : x) v.x() *= 1.05;
+  // Horizontal edges stretch by 5 %, vertical ones not at all.
+  EXPECT_NEAR(p.strain(x).first, 0.05, 1e-12);
+}
+
+TEST(LengthProjector, RestoresLengthsWithHeldVerticesUnmoved) {
+  const Grid g = makeGrid(8, 5, 0.1, 0.06);
+  const LengthProjector p(g.pattern, g.triangles);
+  std::vector<Vec3> x = roll(g.pattern, 0.03);
+  // Deterministic noise of up to 8 % of an edge (1.25 cm edges).
+  for (std::size_t i = 0; i < x.size(); ++i)
+    x[i] += 1e-3 * Vec3(std::sin(7.1 * i), std::cos(3.3 * i), std::sin(1.7 * i + 0.5));
+  std::vector<char> held(x.size(), 0);
+  held[static_cast<std::size_t>(g.at(0, 0))] = 1;
+  held[static_cast<std::size_t>(g.at(g.n, g.m))] = 1;
+  const std::vector<Vec3> start = x;
+  const auto before = p.strain(x);
+  ASSERT_GT(before.first, 0.05);
+  const LengthProjectionStats s = p.project(x, held, 1e-4, 50);
+  EXPECT_LE(s.maxAfter, 1e-4);
+  EXPECT_LT(s.meanAfter, 0.01 * before.second);
+  EXPECT_GT(s.iterations, 0);
+  EXPECT_EQ(x[static_cast<std::size_t>(g.at(0, 0))], start[static_cast<std::size_t>(g.at(0, 0))]);
+  EXPECT_EQ(x[static_cast<std::size_t>(g.at(g.n, g.m))],
+            start[static_cast<std::size_t>(g.at(g.n, g.m))]);
+}
+
+TEST(LengthProjector, NeverRaisesTheMaxStrain) {
+  // Two held corners further apart than the sheet reaches: no isometry; the
+  // projection lowers the residual and returns its iterate of least max.
+  const Grid g = makeGrid(6, 3, 0.1, 0.05);
+  const LengthProjector p(g.pattern, g.triangles);
+  std::vector<Vec3> x = lift(g.pattern);
+  for (Vec3& v : x) v.x() *= 1.1;
+  std::vector<char> held(x.size(), 0);
+  held[static_cast<std::size_t>(g.at(0, 0))] = 1;
+  held[static_cast<std::size_t>(g.at(g.n, 0))] = 1;
+  x[static_cast<std::size_t>(g.at(g.n, 0))].x() = 0.103;  // the held pair 3 % beyond reach
+  // The objective, sum_e r_e^2 (the max may rise: it is not what is minimised).
+  const auto cost = [&](const std::vector<Vec3>& y) {
+    double c = 0.0;
+    for (const Tri& t : g.triangles)
+      for (int k = 0; k < 3; ++k) {
+        const auto a = static_cast<std::size_t>(t[static_cast<std::size_t>(k)]);
+        const auto b = static_cast<std::size_t>(t[static_cast<std::size_t>((k + 1) % 3)]);
+        const double rest = (g.pattern[a] - g.pattern[b]).norm();
+        const double r = ((y[a] - y[b]).norm() - rest) / rest;
+        c += r * r;
+      }
+    return c;
+  };
+  const double before = cost(x);
+  const double maxBefore = p.strain(x).first;
+  const LengthProjectionStats s = p.project(x, held, 0.0, 40);
+  EXPECT_LT(cost(x), before);
+  EXPECT_LT(s.maxAfter, maxBefore);
+  EXPECT_NEAR(s.maxAfter, p.strain(x).first, 1e-15);
+  // The bottom row between the held pair stays strained by about 3 %.
+  EXPECT_GT(s.maxAfter, 0.02);
+  EXPECT_LT(s.maxAfter, 0.05);
+}
+
+TEST(RigidMotion, RecoversARigidMotion) {
+  const Mat3 r = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  const Vec3 t(0.1, -0.2, 0.3);
+  const std::vector<Vec3> a{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.3, 0.2, 0.9}};
+  std::vector<Vec3> b;
+  for (const Vec3& p : a) b.push_back(r * p + t);
+  const RigidMotion m = fitRigidMotion(a, b);
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_LT((m.apply(a[i]) - b[i]).norm(), 1e-12);
+  EXPECT_NEAR(m.rotation.determinant(), 1.0, 1e-12);
+}
+
+TEST(RigidMotion, TwoPointsAndOnePoint) {
+  const std::vector<Vec3> a{{0, 0, 0}, {1, 0, 0}};
+  const std::vector<Vec3> b{{1, 1, 1}, {1, 2, 1}};  // same distance, turned by 90 degrees
+  const RigidMotion m = fitRigidMotion(a, b);
+  EXPECT_LT((m.apply(a[0]) - b[0]).norm(), 1e-12);
+  EXPECT_LT((m.apply(a[1]) - b[1]).norm(), 1e-12);
+  EXPECT_NEAR(m.rotation.determinant(), 1.0, 1e-12);
+  const RigidMotion one = fitRigidMotion({Vec3(1, 2, 3)}, {Vec3(2, 2, 2)});
+  EXPECT_EQ(one.rotation, Mat3::Identity());
+  EXPECT_LT((one.apply(Vec3(0, 0, 0)) - Vec3(1, 0, -1)).norm(), 1e-15);
+}
+
+TEST(TransferByPattern, InterpolatesInsideTheOldTriangles) {
+  const Grid coarse = makeGrid(2, 2, 0.1, 0.1);
+  const std::vector<Vec3> x = roll(coarse.pattern, 0.05);
+  // The same points come back exactly; a midpoint is the mean of its ends.
+  const std::vector<Vec3> same =
+      transferByPattern(coarse.pattern, coarse.triangles, x, coarse.pattern);
+  for (std::size_t i = 0; i < x.size(); ++i) EXPECT_LT((same[i] - x[i]).norm(), 1e-15);
+  const std::vector<Vec2> mid{0.5 * (coarse.pattern[0] + coarse.pattern[1]), Vec2(-0.01, 0.0)};
+  const std::vector<Vec3> m = transferByPattern(coarse.pattern, coarse.triangles, x, mid);
+  EXPECT_LT((m[0] - 0.5 * (x[0] + x[1])).norm(), 1e-15);
+  // Outside the pattern: clamped onto the nearest triangle (its corner here).
+  EXPECT_LT((m[1] - x[0]).norm(), 1e-15);
+}
+
+struct Shot {
+  Grid g = makeGrid(6, 4, 0.1, 0.06);
+  std::vector<int> handles;
+  std::vector<Vec3> before;
+};
+
+TEST(LimitStrain, LeavesAGoodSheetAlone) {
+  Shot s;
+  s.handles = {s.g.at(0, 0)};
+  s.before = lift(s.g.pattern);
+  std::vector<Vec3> x = roll(s.g.pattern, 0.04);
+  const std::vector<Vec3> targets{x[static_cast<std::size_t>(s.handles[0])]};
+  const std::vector<Vec3> start = x;
+  const StrainLimitStats st = limitStrain({s.g.pattern,
+                                           s.g.triangles,
+                                           s.g.pattern,
+                                           s.g.triangles,
+                                           s.before,
+                                           true,
+                                           s.handles,
+                                           targets,
+                                           {}},
+                                          x);
+  EXPECT_FALSE(st.ran);
+  EXPECT_EQ(x, start);
+  EXPECT_EQ(st.lag, 0.0);
+}
+
+TEST(LimitStrain, ACarriedStartFollowsARigidHandleMotion) {
+  // Three handles turned by 60 degrees and moved; the stepped sheet is a
+  // crushed mess far from them. The carried start takes the sheet along.
+  Shot s;
+  s.handles = {s.g.at(0, 0), s.g.at(s.g.n, 0), s.g.at(0, s.g.m)};
+  s.before = roll(s.g.pattern, 0.04);
+  const Mat3 r = Eigen::AngleAxisd(std::numbers::pi / 3, Vec3(0, 0, 1)).toRotationMatrix();
+  const Vec3 t(0.02, 0.01, -0.03);
+  std::vector<Vec3> targets;
+  for (int h : s.handles) targets.push_back(r * s.before[static_cast<std::size_t>(h)] + t);
+  std::vector<Vec3> x(s.before.size(), Vec3::Zero());  // crushed to a point
+  const StrainLimitStats st = limitStrain({s.g.pattern,
+                                           s.g.triangles,
+                                           s.g.pattern,
+                                           s.g.triangles,
+                                           s.before,
+                                           true,
+                                           s.handles,
+                                           targets,
+                                           {}},
+                                          x);
+  EXPECT_TRUE(st.ran);
+  EXPECT_TRUE(st.carried);
+  EXPECT_LE(st.maxAfter, 0.01);
+  EXPECT_LT(st.lag, 1e-12);
+  for (std::size_t i = 0; i < x.size(); ++i) EXPECT_LT((x[i] - (r * s.before[i] + t)).norm(), 1e-4);
+}
+
+TEST(LimitStrain, HandlesBeyondTheSheetsReachLag) {
+  // Two corners pulled 10 % further apart than the pattern allows: no
+  // configuration meets 2 % with them on their targets, so they lag, and the
+  // sheet stays within the bound.
+  Shot s;
+  s.handles = {s.g.at(0, 0), s.g.at(s.g.n, 0)};
+  s.before = lift(s.g.pattern);
+  const std::vector<Vec3> targets{Vec3(-0.005, 0, 0), Vec3(0.105, 0, 0)};
+  std::vector<Vec3> x = s.before;
+  for (Vec3& v : x) v.x() = -0.005 + 1.1 * v.x();
+  const StrainLimitStats st = limitStrain({s.g.pattern,
+                                           s.g.triangles,
+                                           s.g.pattern,
+                                           s.g.triangles,
+                                           s.before,
+                                           true,
+                                           s.handles,
+                                           targets,
+                                           {}},
+                                          x);
+  EXPECT_TRUE(st.ran);
+  EXPECT_LE(st.maxAfter, 0.02);
+  EXPECT_GT(st.lag, 0.001);  // they meet about 2 mm of the 10 mm asked
+  EXPECT_LT(st.lag, 0.005);
+  EXPECT_TRUE(st.lagVertex == s.handles[0] || st.lagVertex == s.handles[1]);
+}
+
+TEST(LimitStrain, ARebuiltSheetIsCarriedByPattern) {
+  // The step's start is a coarser mesh of the same pattern: the carried start
+  // interpolates it.
+  Shot s;
+  const Grid coarse = makeGrid(3, 2, 0.1, 0.06);
+  s.handles = {0};
+  const std::vector<Vec3> before = lift(coarse.pattern);
+  const std::vector<Vec3> targets{Vec3(0.0, 0.0, 0.01)};
+  std::vector<Vec3> x(s.g.pattern.size(), Vec3::Zero());  // crushed to a point
+  const StrainLimitStats st = limitStrain({s.g.pattern,
+                                           s.g.triangles,
+                                           coarse.pattern,
+                                           coarse.triangles,
+                                           before,
+                                           false,
+                                           s.handles,
+                                           targets,
+                                           {}},
+                                          x);
+  EXPECT_TRUE(st.carried);
+  EXPECT_LE(st.maxAfter, 0.01);
+  EXPECT_LT(st.lag, 1e-12);
+  EXPECT_NEAR(x.back().z(), 0.01, 1e-9);
+}
+
+}  // namespace
+}  // namespace crumple::paper
