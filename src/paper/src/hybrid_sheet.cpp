@@ -482,10 +482,6 @@ int HybridSheet::interiorSingularVertexCount() const {
                     [](const GeometricVertex& v) { return v.singular && !v.onBoundary; }));
 }
 
-// One animation step of the paper (Fig. 16, thesis Algorithm 1) from t to
-// t + dt: an elastic step of S_P, S_P -> S_G, the geometric step, cone
-// fitting, S_P rebuilt from S_G and the isometry projection. `stage` names
-// the stage running, for the error message when it throws.
 // Paper stays paper after the isometry (strain_limit.hpp): S_P within
 // maxEdgeStrain, the handles on their targets or lagging; a remeshing that
 // leaves no configuration within the bound is undone.
@@ -540,13 +536,18 @@ void HybridSheet::Impl::limitStepStrain(const mesh::SheetMesh& spBefore,
   if (!allFinite(positions)) throw NumericalError("strain limit", frame, "non-finite positions");
 }
 
+// One animation step of the paper (Fig. 16, thesis Algorithm 1) from t to
+// t + dt: an elastic step of S_P, S_P -> S_G, the geometric step, cone
+// fitting, S_P rebuilt from S_G, the isometry projection and (with
+// maxEdgeStrain) the strain limit. `stage` names
+// the stage running, for the error message when it throws.
 void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunction& pins, int frame,
                                       int singularBudget, std::uint64_t& draw,
                                       HybridStepStats& stats, const char*& stage) {
   Impl& m = *this;
   // The step's start, for the strain limit's carried start and for undoing
   // a structure change it cannot bound.
-  const mesh::SheetMesh spBefore = m.sp.mesh;
+  const mesh::SheetMesh spBefore = m.params.maxEdgeStrain > 0.0 ? m.sp.mesh : mesh::SheetMesh{};
   const GeometricMesh sgBefore = m.params.maxEdgeStrain > 0.0 ? m.sg : GeometricMesh{};
   CrumpleParams stepParams = m.params;
   stepParams.maxSingularPerFrame = singularBudget;
@@ -768,23 +769,7 @@ HybridStepStats HybridSheet::advance(double t, double dt, int substeps,
       accumulate(stats, s);
     }
   } catch (const std::exception& e) {
-    if (const char* dump = std::getenv("CRUMPLE_DEBUG_DUMP"); dump != nullptr) {
-      // Developer aid: the S_P that failed, as OBJ (pattern as vt).
-      std::FILE* f = std::fopen(dump, "w");
-      if (f != nullptr) {
-        const auto& mm = m.sp.mesh;
-        std::vector<int> uses(mm.vertexCount(), 0);
-        for (const auto& t : mm.triangles)
-          for (int k : t) ++uses[static_cast<std::size_t>(k)];
-        for (std::size_t i = 0; i < mm.vertexCount(); ++i)
-          std::fprintf(f, "v %.9g %.9g %.9g\n# uses %d pattern %.9g %.9g sg %d\n",
-                       mm.positions[i].x(), mm.positions[i].y(), mm.positions[i].z(), uses[i],
-                       mm.pattern[i].x(), mm.pattern[i].y(), i < m.sg.vertices.size() ? 1 : 0);
-        for (const auto& t : mm.triangles)
-          std::fprintf(f, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);
-        std::fclose(f);
-      }
-    }
+    detail::dumpFailedStep(m.sp.mesh, m.sg.vertices.size());
     m.sg = sgBefore;
     m.time = t;
     m.elastic.reset();

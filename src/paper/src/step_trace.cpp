@@ -127,4 +127,20 @@ void printStepTrace(int level, int frame, const GeometricMesh& sg, const Physica
   for (const std::string& note : gs.notes) std::fprintf(stderr, "[geometry]   %s\n", note.c_str());
 }
 
+void dumpFailedStep(const mesh::SheetMesh& mm, std::size_t geometricCount) {
+  const char* dump = std::getenv("CRUMPLE_DEBUG_DUMP");
+  if (dump == nullptr) return;
+  std::FILE* f = std::fopen(dump, "w");
+  if (f == nullptr) return;
+  std::vector<int> uses(mm.vertexCount(), 0);
+  for (const auto& t : mm.triangles)
+    for (int k : t) ++uses[static_cast<std::size_t>(k)];
+  for (std::size_t i = 0; i < mm.vertexCount(); ++i)
+    std::fprintf(f, "v %.9g %.9g %.9g\n# uses %d pattern %.9g %.9g sg %d\n", mm.positions[i].x(),
+                 mm.positions[i].y(), mm.positions[i].z(), uses[i], mm.pattern[i].x(),
+                 mm.pattern[i].y(), i < geometricCount ? 1 : 0);
+  for (const auto& t : mm.triangles) std::fprintf(f, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);
+  std::fclose(f);
+}
+
 }  // namespace crumple::paper::detail

@@ -24,4 +24,8 @@ void printStepTrace(int level, int frame, const GeometricMesh& sg, const Physica
                     const sim::ElasticSheet& elastic, const HybridStepStats& stats,
                     const std::vector<sim::Pin>& pinned, const std::array<double, 3>& hinge);
 
+// Developer aid: with CRUMPLE_DEBUG_DUMP=FILE, the S_P of a failed step as
+// OBJ (pattern as comments; `geometricCount`: its first vertices are S_G's).
+void dumpFailedStep(const mesh::SheetMesh& sp, std::size_t geometricCount);
+
 }  // namespace crumple::paper::detail
