@@ -154,10 +154,16 @@ TEST(TransferByPattern, InterpolatesInsideTheOldTriangles) {
   EXPECT_LT((m[1] - x[0]).norm(), 1e-15);
 }
 
+// A step on one grid: its start `before` and its handles; limit() runs the
+// stage on `x` with S_P unchanged over the step.
 struct Shot {
   Grid g = makeGrid(6, 4, 0.1, 0.06);
   std::vector<int> handles;
   std::vector<Vec3> before;
+  StrainLimitStats limit(std::vector<Vec3>& x, const std::vector<Vec3>& targets) const {
+    return limitStrain(
+        {g.pattern, g.triangles, g.pattern, g.triangles, before, true, handles, targets, {}}, x);
+  }
 };
 
 TEST(LimitStrain, LeavesAGoodSheetAlone) {
@@ -167,16 +173,7 @@ TEST(LimitStrain, LeavesAGoodSheetAlone) {
   std::vector<Vec3> x = roll(s.g.pattern, 0.04);
   const std::vector<Vec3> targets{x[static_cast<std::size_t>(s.handles[0])]};
   const std::vector<Vec3> start = x;
-  const StrainLimitStats st = limitStrain({s.g.pattern,
-                                           s.g.triangles,
-                                           s.g.pattern,
-                                           s.g.triangles,
-                                           s.before,
-                                           true,
-                                           s.handles,
-                                           targets,
-                                           {}},
-                                          x);
+  const StrainLimitStats st = s.limit(x, targets);
   EXPECT_FALSE(st.ran);
   EXPECT_EQ(x, start);
   EXPECT_EQ(st.lag, 0.0);
@@ -193,16 +190,7 @@ TEST(LimitStrain, ACarriedStartFollowsARigidHandleMotion) {
   std::vector<Vec3> targets;
   for (int h : s.handles) targets.push_back(r * s.before[static_cast<std::size_t>(h)] + t);
   std::vector<Vec3> x(s.before.size(), Vec3::Zero());  // crushed to a point
-  const StrainLimitStats st = limitStrain({s.g.pattern,
-                                           s.g.triangles,
-                                           s.g.pattern,
-                                           s.g.triangles,
-                                           s.before,
-                                           true,
-                                           s.handles,
-                                           targets,
-                                           {}},
-                                          x);
+  const StrainLimitStats st = s.limit(x, targets);
   EXPECT_TRUE(st.ran);
   EXPECT_TRUE(st.carried);
   EXPECT_LE(st.maxAfter, 0.01);
@@ -220,16 +208,7 @@ TEST(LimitStrain, HandlesBeyondTheSheetsReachLag) {
   const std::vector<Vec3> targets{Vec3(-0.005, 0, 0), Vec3(0.105, 0, 0)};
   std::vector<Vec3> x = s.before;
   for (Vec3& v : x) v.x() = -0.005 + 1.1 * v.x();
-  const StrainLimitStats st = limitStrain({s.g.pattern,
-                                           s.g.triangles,
-                                           s.g.pattern,
-                                           s.g.triangles,
-                                           s.before,
-                                           true,
-                                           s.handles,
-                                           targets,
-                                           {}},
-                                          x);
+  const StrainLimitStats st = s.limit(x, targets);
   EXPECT_TRUE(st.ran);
   EXPECT_LE(st.maxAfter, 0.02);
   EXPECT_GT(st.lag, 0.001);  // they meet about 2 mm of the 10 mm asked
