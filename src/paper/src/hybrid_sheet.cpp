@@ -167,6 +167,7 @@ struct HybridSheet::Impl {
   // S_P hinge angle after the elastic step, the rebuild and the isometry.
   int traceLevel = detail::stepTraceLevel();
   std::array<double, 3> traceHinge{};
+  double traceElasticStrain = 0.0;  // max |r_e| of S_P as the elastic step left it
   void noteHinge(int stage) {
     if (traceLevel > 0)
       traceHinge[static_cast<std::size_t>(stage)] = detail::maxHingeAngle(*elastic);
@@ -574,6 +575,8 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
   const std::vector<Vec2> elasticPattern = m.sp.mesh.pattern;
   const std::vector<Vec3>& x = m.elastic->positions();
   const std::vector<Vec3>& v = m.elastic->velocities();
+  if (m.traceLevel > 0)
+    m.traceElasticStrain = LengthProjector(m.sp.mesh.pattern, m.sp.mesh.triangles).strain(x).first;
   // (c) S_P -> S_G.
   for (std::size_t i = 0; i < m.sg.vertices.size(); ++i) {
     m.sg.vertices[i].position = x[i];
@@ -743,8 +746,8 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
   if (m.traceLevel > 0) {
     std::vector<sim::Pin> pinned;
     pins(t + dt, pinned);
-    detail::printStepTrace(m.traceLevel, frame, m.sg, m.sp, *m.elastic, stats, pinned,
-                           m.traceHinge);
+    detail::printStepTrace(m.traceLevel, frame, m.sg, m.sp, *m.elastic, stats, pinned, m.traceHinge,
+                           m.traceElasticStrain);
   }
 }
 

@@ -24,7 +24,8 @@ double maxHingeAngle(const sim::ElasticSheet& elastic) {
 
 void printStepTrace(int level, int frame, const GeometricMesh& sg, const PhysicalMesh& sp,
                     const sim::ElasticSheet& elastic, const HybridStepStats& stats,
-                    const std::vector<sim::Pin>& pinned, const std::array<double, 3>& hinge) {
+                    const std::vector<sim::Pin>& pinned, const std::array<double, 3>& hinge,
+                    double elasticStrain) {
   // Developer trace of the geometric step, one line per frame.
   int curved = 0;
   for (const Region& r : sg.regions) curved += r.type == mesh::RegionType::Curved ? 1 : 0;
@@ -82,8 +83,14 @@ void printStepTrace(int level, int frame, const GeometricMesh& sg, const Physica
                  static_cast<std::size_t>(k) < sg.vertices.size() ? "g" : "", 100 * p.x(),
                  100 * p.y());
   }
+  // Max edge strain as the elastic step left S_P, and the strain limit's
+  // view of the last step (before -> after, the handles' largest lag).
+  const StrainLimitStats& lim = stats.strainLimit;
+  std::fprintf(stderr, "; edge strain elastic %.4f, limit %.4f -> %.4f, lag %.3g m%s",
+               elasticStrain, lim.maxBefore, lim.maxAfter, lim.lag,
+               lim.carried ? " (carried)" : "");
   std::fprintf(stderr, "\n");
-  if (level == 3) {  // the worst edges after the isometry
+  if (level == 3) {  // the worst edges at the step's end (isometry, strain limit, contacts)
     std::vector<char> isPinned(sp.mesh.vertexCount(), 0);
     for (const auto& p : pinned) isPinned[static_cast<std::size_t>(p.vertex)] = 1;
     std::vector<std::pair<double, std::array<int, 2>>> errs;

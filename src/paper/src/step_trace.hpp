@@ -22,7 +22,8 @@ double maxHingeAngle(const sim::ElasticSheet& elastic);
 // after the elastic step, the S_P rebuild and the isometry.
 void printStepTrace(int level, int frame, const GeometricMesh& sg, const PhysicalMesh& sp,
                     const sim::ElasticSheet& elastic, const HybridStepStats& stats,
-                    const std::vector<sim::Pin>& pinned, const std::array<double, 3>& hinge);
+                    const std::vector<sim::Pin>& pinned, const std::array<double, 3>& hinge,
+                    double elasticStrain);
 
 // Developer aid: with CRUMPLE_DEBUG_DUMP=FILE, the S_P of a failed step as
 // OBJ (pattern as comments; `geometricCount`: its first vertices are S_G's).
