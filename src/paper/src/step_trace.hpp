@@ -19,7 +19,8 @@ double maxHingeAngle(const sim::ElasticSheet& elastic);
 
 // Prints the trace of one animation step of frame `frame` at `level`.
 // `pinned`: the pins at the step's end; `hinge`: the largest hinge angle
-// after the elastic step, the S_P rebuild and the isometry.
+// after the elastic step, the S_P rebuild and the isometry; `elasticStrain`:
+// the largest edge strain of S_P as the elastic step left it.
 void printStepTrace(int level, int frame, const GeometricMesh& sg, const PhysicalMesh& sp,
                     const sim::ElasticSheet& elastic, const HybridStepStats& stats,
                     const std::vector<sim::Pin>& pinned, const std::array<double, 3>& hinge,
