@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -16,7 +17,7 @@
 namespace crumple::pipeline {
 namespace {
 
-constexpr std::uint32_t kCheckpointVersion = 2;
+constexpr std::uint32_t kCheckpointVersion = 3;
 constexpr char kMagic[9] = "CRUMPCKP";
 
 std::uint32_t sceneHash(const io::SceneSpec& scene) {
@@ -133,6 +134,14 @@ void saveReport(StateWriter& w, const ShotReport& r) {
   w.f64(r.maxCMean);
   w.i32(r.maxCMeanFrame);
   w.f64(r.maxNComp);
+  w.count(r.handleLags.size());
+  for (const auto& h : r.handleLags) {
+    w.str(h.name);
+    w.i32(h.frames);
+    w.i32(h.firstFrame);
+    w.f64(h.max);
+    w.i32(h.maxFrame);
+  }
   w.count(r.stages.size());
   for (const auto& [name, cost] : r.stages) {
     w.str(name);
@@ -168,6 +177,16 @@ void restoreReport(StateReader& in, ShotReport& r) {
   r.maxCMean = in.f64();
   r.maxCMeanFrame = in.i32();
   r.maxNComp = in.f64();
+  r.handleLags.resize(in.count(24));
+  for (auto& h : r.handleLags) {
+    h.name = in.str();
+    h.frames = in.i32();
+    h.firstFrame = in.i32();
+    h.max = in.f64();
+    h.maxFrame = in.i32();
+    if (h.frames < 0 || !std::isfinite(h.max) || h.max < 0.0)
+      in.fail("a handle's lag record is out of range");
+  }
   r.stages.clear();
   const std::size_t n = in.count(24);
   for (std::size_t k = 0; k < n; ++k) {

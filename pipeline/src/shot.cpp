@@ -124,6 +124,27 @@ constexpr double kLengthErrorWarning = 0.01;
 // A handle further than this from its node lags (strain_limit.hpp).
 constexpr double kLagReported = 1e-6;
 
+// Adds one frame's lag of each handle (strain limit: (vertex, lag)) to the
+// per-handle record, one entry per handle of the rig in its order.
+void noteHandleLags(const HandleRig& rig, const std::vector<std::pair<int, double>>& lags,
+                    int frame, std::vector<ShotReport::HandleLag>& record) {
+  const auto& handles = rig.handles();
+  if (record.size() != handles.size()) {
+    record.assign(handles.size(), {});
+    for (std::size_t h = 0; h < handles.size(); ++h) record[h].name = handles[h].name;
+  }
+  for (std::size_t h = 0; h < handles.size(); ++h)
+    for (const auto& [vertex, lag] : lags) {
+      if (vertex != handles[h].vertex || lag <= kLagReported) continue;
+      ShotReport::HandleLag& r = record[h];
+      if (r.frames++ == 0) r.firstFrame = frame;
+      if (lag > r.max) {
+        r.max = lag;
+        r.maxFrame = frame;
+      }
+    }
+}
+
 paper::CrumpleParams crumpleParamsOf(const io::HybridSpec& h) {
   paper::CrumpleParams p;
   p.rhoBound = h.rhoBound;
@@ -593,16 +614,14 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
           "the elastic solve failed with self-contact and went on without it at frames " +
           std::to_string(selfContactDropped.first) + "-" +
           std::to_string(selfContactDropped.second) + ": the sheet may pass through itself there");
-    if (report.lagFrames > 0) {
-      std::string who = "a handle";
-      for (const auto& h : rig.handles())
-        if (h.vertex == report.maxHandleLagVertex) who = "handle '" + h.name + "'";
-      char text[320];
+    for (const auto& h : report.handleLags) {
+      if (h.frames == 0) continue;
+      char text[400];
       std::snprintf(text, sizeof text,
-                    "%s lags behind its node on %d frames, up to %.3g mm at frame %d: the sheet "
-                    "cannot follow there without stretching over [model] max_edge_strain",
-                    who.c_str(), report.lagFrames, 1e3 * report.maxHandleLag,
-                    report.maxHandleLagFrame);
+                    "handle '%s' lags behind its node on %d frames from frame %d, up to %.3g mm "
+                    "at frame %d: the sheet cannot follow there without stretching over [model] "
+                    "max_edge_strain",
+                    h.name.c_str(), h.frames, h.firstFrame, 1e3 * h.max, h.maxFrame);
       report.warnings.push_back(text);
     }
     for (const auto& [h, span] : beyondReach) {
@@ -1067,6 +1086,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
           report.maxHandleLagFrame = frame;
           report.maxHandleLagVertex = stats.strainLimit.lagVertex;
         }
+        noteHandleLags(rig, stats.strainLimit.handleLags, frame, report.handleLags);
         report.substeps += scene.substeps;
         report.contactMs += stats.elastic.contactMs + stats.ms.contacts;
         report.selfContactMs += stats.elastic.selfContactMs + stats.ms.selfContacts;
@@ -1396,6 +1416,18 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
     j.key("max_handle_lag").value(r.maxHandleLag);
     j.key("max_handle_lag_frame").value(static_cast<long long>(r.maxHandleLagFrame));
     j.key("max_handle_lag_vertex").value(static_cast<long long>(r.maxHandleLagVertex));
+    j.key("handle_lags").beginArray();
+    for (const auto& h : r.handleLags) {
+      if (h.frames == 0) continue;
+      j.beginObject();
+      j.key("handle").value(h.name);
+      j.key("frames").value(static_cast<long long>(h.frames));
+      j.key("first_frame").value(static_cast<long long>(h.firstFrame));
+      j.key("max_lag").value(h.max);
+      j.key("max_lag_frame").value(static_cast<long long>(h.maxFrame));
+      j.endObject();
+    }
+    j.endArray();
     j.endObject();
   }
   j.key("warnings").beginArray();

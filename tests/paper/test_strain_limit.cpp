@@ -216,6 +216,54 @@ TEST(LimitStrain, HandlesBeyondTheSheetsReachLag) {
   EXPECT_TRUE(st.lagVertex == s.handles[0] || st.lagVertex == s.handles[1]);
 }
 
+TEST(LimitStrain, EachHandleLagsOnlyAsFarAsItMust) {
+  // The two bottom corners pulled 10 % beyond their reach; of the top
+  // corners one stays and one is lifted 5 mm, which the sheet can follow by
+  // folding. The bottom corners lag; the top ones do not lag with them
+  // (one uniform lag of every handle holds them back by their fraction).
+  Shot s;
+  s.handles = {s.g.at(0, 0), s.g.at(s.g.n, 0), s.g.at(0, s.g.m), s.g.at(s.g.n, s.g.m)};
+  s.before = lift(s.g.pattern);
+  const Vec3 left = s.before[static_cast<std::size_t>(s.handles[2])];
+  const Vec3 right = s.before[static_cast<std::size_t>(s.handles[3])];
+  const std::vector<Vec3> targets{Vec3(-0.005, 0, 0), Vec3(0.105, 0, 0), left,
+                                  right + Vec3(0, 0, 0.005)};
+  std::vector<Vec3> x = s.before;
+  for (Vec3& v : x) v.x() = -0.005 + 1.1 * v.x();
+  const StrainLimitStats st = s.limit(x, targets);
+  EXPECT_TRUE(st.ran);
+  EXPECT_LE(st.maxAfter, 0.02);
+  ASSERT_EQ(st.handleLags.size(), 4U);
+  for (std::size_t h = 0; h < 4; ++h) EXPECT_EQ(st.handleLags[h].first, s.handles[h]);
+  EXPECT_GT(st.handleLags[0].second + st.handleLags[1].second, 0.002);
+  // Measured: 0.003 mm (top left) and 0.23 mm (top right), both 1.15 mm with
+  // one uniform lag.
+  EXPECT_LT(st.handleLags[2].second, 0.1 * 0.005);
+  EXPECT_LT(st.handleLags[3].second, 0.1 * 0.005);
+  EXPECT_NEAR(st.lag, std::max(st.handleLags[0].second, st.handleLags[1].second), 1e-15);
+}
+
+TEST(LengthProjector, TowardsTargetsWithinTheBound) {
+  // projectTowards from the flat sheet: a corner asked 5 mm up reaches it
+  // (the sheet bends), one asked 10 mm along the sheet, beyond its reach,
+  // stops where the bound holds, and no edge ends over the bound.
+  const Grid g = makeGrid(6, 4, 0.1, 0.06);
+  const LengthProjector p(g.pattern, g.triangles);
+  std::vector<Vec3> x = lift(g.pattern);
+  std::vector<char> held(x.size(), 0);
+  held[static_cast<std::size_t>(g.at(0, 0))] = 1;
+  held[static_cast<std::size_t>(g.at(0, g.m))] = 1;
+  const int up = g.at(g.n, g.m), along = g.at(g.n, 0);
+  const std::vector<Vec3> targets{x[static_cast<std::size_t>(up)] + Vec3(0, 0, 0.005),
+                                  x[static_cast<std::size_t>(along)] + Vec3(0.01, 0, 0)};
+  p.projectTowards(x, held, {up, along}, targets, 0.02, 200);
+  EXPECT_LE(p.strain(x).first, 0.02);
+  EXPECT_LT((x[static_cast<std::size_t>(up)] - targets[0]).norm(), 2e-4);
+  const double reach = (x[static_cast<std::size_t>(along)] - targets[1]).norm();
+  EXPECT_GT(reach, 0.007);  // at most ~2 % of 10 cm of the 10 mm
+  EXPECT_LT(reach, 0.0099);
+}
+
 TEST(LimitStrain, ARebuiltSheetIsCarriedByPattern) {
   // The step's start is a coarser mesh of the same pattern: the carried start
   // interpolates it.

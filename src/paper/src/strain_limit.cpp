@@ -54,27 +54,60 @@ std::pair<double, double> LengthProjector::strain(const std::vector<Vec3>& x) co
 
 LengthProjectionStats LengthProjector::project(std::vector<Vec3>& x, const std::vector<char>& held,
                                                double target, int maxIterations) const {
+  return solve(x, held, {}, {}, target, 0.0, maxIterations);
+}
+
+LengthProjectionStats LengthProjector::projectTowards(std::vector<Vec3>& x,
+                                                      const std::vector<char>& held,
+                                                      const std::vector<int>& handles,
+                                                      const std::vector<Vec3>& targets,
+                                                      double bound, int maxIterations) const {
+  return solve(x, held, handles, targets, 0.0, bound, maxIterations);
+}
+
+// The Levenberg-Marquardt core of project and projectTowards: Gauss-Newton
+// on F(x) = sum_e w_e r_e^2 + (kHandleWeight / l^2) sum_h |x_h - t_h|^2 with
+// w_e = 1 + kBoundWeight [|r_e| > kSoftBound bound] (bound > 0 only), l the
+// mean rest length. With no handles it stops at max |r_e| <= target and
+// returns the least-max iterate; with handles it runs to convergence and
+// returns the last (least-F) iterate.
+LengthProjectionStats LengthProjector::solve(std::vector<Vec3>& x, const std::vector<char>& held,
+                                             const std::vector<int>& handles,
+                                             const std::vector<Vec3>& targets, double target,
+                                             double bound, int maxIterations) const {
   LengthProjectionStats stats;
   std::tie(stats.maxBefore, stats.meanBefore) = strain(x);
   stats.maxAfter = stats.maxBefore;
   stats.meanAfter = stats.meanBefore;
-  if (stats.maxBefore <= target || maxIterations <= 0) return stats;
+  const bool towards = !handles.empty();
+  if ((!towards && stats.maxBefore <= target) || maxIterations <= 0) return stats;
   std::vector<int> column(vertexCount_, -1);
   int free = 0;
   for (int v : used_)
     if (at(v) >= held.size() || held[at(v)] == 0) column[at(v)] = free++;
   if (free == 0) return stats;
+  double meanRest = 0.0;
+  for (double r : rest_) meanRest += r;
+  meanRest /= std::max<std::size_t>(1, rest_.size());
+  const double handleWeight = towards ? kHandleWeight / (meanRest * meanRest) : 0.0;
+  const double soft = kSoftBound * bound;
+  // An edge's residual weight: over the soft bound it costs kBoundWeight more.
+  const auto weight = [&](double r) {
+    return bound > 0.0 && std::abs(r) > soft ? 1.0 + kBoundWeight : 1.0;
+  };
   const auto cost = [&](const std::vector<Vec3>& p) {
     double s = 0.0;
     for (std::size_t k = 0; k < edges_.size(); ++k) {
       const double r = ((p[at(edges_[k][1])] - p[at(edges_[k][0])]).norm() - rest_[k]) / rest_[k];
-      s += r * r;
+      s += r * r + (weight(r) - 1.0) * (std::abs(r) - soft) * (std::abs(r) - soft);
     }
+    for (std::size_t h = 0; h < handles.size(); ++h)
+      s += handleWeight * (p[at(handles[h])] - targets[h]).squaredNorm();
     return s;
   };
   const Eigen::Index n = 3 * static_cast<Eigen::Index>(free);
-  // Gauss-Newton matrix J^T J and gradient J^T r; J's rows d r_e / d x are
-  // -u, +u on the edge's ends with u = d / (l L).
+  // Gauss-Newton matrix J^T W J and gradient J^T W r; J's rows d r_e / d x
+  // are -u, +u on the edge's ends with u = d / (l L).
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(edges_.size() * 36 + static_cast<std::size_t>(n));
   Eigen::SparseMatrix<double> H(n, n);
@@ -94,6 +127,10 @@ LengthProjectionStats LengthProjector::project(std::vector<Vec3>& x, const std::
       const Vec3 d = x[at(b)] - x[at(a)];
       const double l = d.norm();
       const double r = (l - rest_[k]) / rest_[k];
+      const double w = weight(r);
+      // The penalty's residual is |r| - soft, so its gradient term is
+      // (w - 1)(|r| - soft) sign(r) u beside the plain r u.
+      const double gr = r + (w - 1.0) * (std::abs(r) - soft) * (r < 0.0 ? -1.0 : 1.0);
       // A collapsed edge has no direction; its zero block keeps the sparsity
       // pattern the symbolic analysis was made for.
       const Vec3 u = l > 0.0 ? Vec3(d / (l * rest_[k])) : Vec3::Zero();
@@ -101,10 +138,10 @@ LengthProjectionStats LengthProjector::project(std::vector<Vec3>& x, const std::
       const std::array<double, 2> sign{-1.0, 1.0};
       for (int i = 0; i < 2; ++i) {
         if (cols[at(i)] < 0) continue;
-        g.segment<3>(3 * cols[at(i)]) += sign[at(i)] * r * u;
+        g.segment<3>(3 * cols[at(i)]) += sign[at(i)] * gr * u;
         for (int j = 0; j < 2; ++j) {
           if (cols[at(j)] < 0) continue;
-          const Mat3 block = sign[at(i)] * sign[at(j)] * u * u.transpose();
+          const Mat3 block = w * sign[at(i)] * sign[at(j)] * u * u.transpose();
           for (int p = 0; p < 3; ++p)
             for (int q = 0; q < 3; ++q)
               triplets.emplace_back(3 * cols[at(i)] + p, 3 * cols[at(j)] + q, block(p, q));
@@ -113,6 +150,12 @@ LengthProjectionStats LengthProjector::project(std::vector<Vec3>& x, const std::
     }
     // The diagonal always in the pattern, so one symbolic analysis serves.
     for (Eigen::Index i = 0; i < n; ++i) triplets.emplace_back(i, i, 0.0);
+    for (std::size_t h = 0; h < handles.size(); ++h) {
+      const int c = column[at(handles[h])];
+      if (c < 0) continue;
+      g.segment<3>(3 * c) += handleWeight * (x[at(handles[h])] - targets[h]);
+      for (int p = 0; p < 3; ++p) triplets.emplace_back(3 * c + p, 3 * c + p, handleWeight);
+    }
     H.setFromTriplets(triplets.begin(), triplets.end());
     const Eigen::VectorXd diag = H.diagonal();
     const double floor = 1e-9 * std::max(1e-300, diag.maxCoeff());
@@ -151,6 +194,7 @@ LengthProjectionStats LengthProjector::project(std::vector<Vec3>& x, const std::
       }
     }
     if (!accepted) break;
+    if (towards) continue;
     const double mx = strain(x).first;
     if (mx < bestMax) {
       bestMax = mx;
@@ -158,7 +202,7 @@ LengthProjectionStats LengthProjector::project(std::vector<Vec3>& x, const std::
     }
     if (mx <= target) break;
   }
-  x = std::move(bestX);
+  if (!towards) x = std::move(bestX);
   std::tie(stats.maxAfter, stats.meanAfter) = strain(x);
   return stats;
 }
@@ -257,6 +301,9 @@ constexpr double kAim = 0.5;
 // The local first attempt frees the vertices this many edges around the
 // edges over the bound.
 constexpr int kLocalRings = 2;
+// Levenberg-Marquardt steps of a projectTowards solve (it runs to
+// convergence, not to a bound).
+constexpr int kTowardsIterations = 60;
 
 void placeHandles(std::vector<Vec3>& x, const std::vector<int>& handles,
                   const std::vector<Vec3>& where) {
@@ -273,8 +320,10 @@ StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
   const auto finish = [&](std::vector<Vec3> chosen) {
     x = std::move(chosen);
     std::tie(s.maxAfter, s.meanAfter) = projector.strain(x);
+    s.handleLags.clear();
     for (std::size_t h = 0; h < in.handles.size(); ++h) {
       const double d = (x[at(in.handles[h])] - in.targets[h]).norm();
+      s.handleLags.emplace_back(in.handles[h], d);
       if (d > s.lag) {
         s.lag = d;
         s.lagVertex = in.handles[h];
@@ -345,6 +394,37 @@ StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
     }
     return finish(std::move(best));
   }
+  // 3a. Each handle as near its target as the bound lets it
+  // (projectTowards), from the carried start and from the stepped sheet:
+  // the candidate within the bound with the least summed squared lag.
+  {
+    const std::vector<char> none(in.pattern.size(), 0);
+    const auto sumLag = [&](const std::vector<Vec3>& p) {
+      double sum = 0.0;
+      for (std::size_t h = 0; h < in.handles.size(); ++h)
+        sum += (p[at(in.handles[h])] - in.targets[h]).squaredNorm();
+      return sum;
+    };
+    std::vector<Vec3> chosen;
+    double chosenLag = std::numeric_limits<double>::infinity();
+    for (const std::vector<Vec3>* from : {&feasible, &x}) {
+      std::vector<Vec3> trial = *from;
+      stats = projector.projectTowards(trial, none, in.handles, in.targets, in.bound,
+                                       kTowardsIterations);
+      s.iterations += stats.iterations;
+      if (stats.maxAfter > in.bound) continue;
+      if (const double lag = sumLag(trial); lag < chosenLag) {
+        chosenLag = lag;
+        chosen = std::move(trial);
+      }
+    }
+    if (!chosen.empty() && chosenLag < sumLag(feasible)) {
+      s.carried = true;
+      return finish(std::move(chosen));
+    }
+  }
+  // 3b. Else all handles on the way from their carried positions to their
+  // targets together, as far as the bound allows (bisection).
   double lo = 0.0, hi = 1.0;
   for (int k = 0; k < 5; ++k) {
     const double mid = 0.5 * (lo + hi);

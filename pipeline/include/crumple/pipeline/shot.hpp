@@ -93,6 +93,16 @@ struct ShotReport {
   double maxHandleLag = 0.0;  // metres
   int maxHandleLagFrame = -1;
   int maxHandleLagVertex = -1;
+  // Each handle of the scene (in scene order) and how it lagged: on how many
+  // frames (over 1 um), from which frame, its largest lag and that frame.
+  struct HandleLag {
+    std::string name;
+    int frames = 0;
+    int firstFrame = -1;
+    double max = 0.0;  // metres
+    int maxFrame = -1;
+  };
+  std::vector<HandleLag> handleLags;
   // Contacts (issue 5): collider and self-contact work (detection, the
   // failsafe; within the elastic stage, plus the crumpling model's failsafe
   // after its isometry), the deepest free vertex inside a collider or the

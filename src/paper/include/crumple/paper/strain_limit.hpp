@@ -16,11 +16,15 @@
 //     1976), is isometric by construction; the projection from there
 //     reaches configurations the stepped sheet cannot.
 //  3. Lag: when neither start meets the bound with the handles on their
-//     targets, the handles are held on the segment from their carried
-//     positions (alpha = 0, lengths exact) to their targets (alpha = 1),
-//     at the largest alpha found by bisection that meets the bound. The
-//     handle rig pulls them on at the next step.
+//     targets, each handle is brought as near its target as the bound lets
+//     it (LengthProjector::projectTowards, from the carried start and from
+//     the stepped sheet), so one handle that cannot follow does not hold
+//     the others back. Failing that, the handles are held together on the
+//     segment from their carried positions (alpha = 0, lengths exact) to
+//     their targets (alpha = 1), at the largest alpha found by bisection
+//     that meets the bound. The handle rig pulls them on at the next step.
 #include <array>
+#include <utility>
 #include <vector>
 
 #include "crumple/core/types.hpp"
@@ -50,6 +54,23 @@ class LengthProjector {
   LengthProjectionStats project(std::vector<Vec3>& x, const std::vector<char>& held, double target,
                                 int maxIterations) const;
 
+  // The handles as soft targets (a finger's grip, not a pin): Levenberg-
+  // Marquardt on sum_e r_e^2 + kBoundWeight sum_e max(0, |r_e| - kSoftBound
+  // bound)^2 + (kHandleWeight / l^2) sum_h |x_h - t_h|^2 (l the mean rest
+  // length), `handles` free unless `held`. Within the bound the handles win
+  // over the lengths, beyond it the lengths win: each handle gets as near
+  // its target as the bound lets it, so one handle that cannot follow does
+  // not stop the others (a penalty form of min sum_h |x_h - t_h|^2 subject
+  // to |r_e| <= bound). Runs to convergence; the bound is not guaranteed,
+  // the caller checks it.
+  LengthProjectionStats projectTowards(std::vector<Vec3>& x, const std::vector<char>& held,
+                                       const std::vector<int>& handles,
+                                       const std::vector<Vec3>& targets, double bound,
+                                       int maxIterations) const;
+  static constexpr double kHandleWeight = 1e2;
+  static constexpr double kBoundWeight = 1e6;
+  static constexpr double kSoftBound = 0.75;
+
   // held[v] = 1 for every vertex more than `rings` edges away from an edge
   // with |r_e| > `above` (added to `held`): a local projection moves only
   // the neighbourhood of the edges that break a bound.
@@ -59,6 +80,9 @@ class LengthProjector {
   [[nodiscard]] std::size_t edgeCount() const { return edges_.size(); }
 
  private:
+  LengthProjectionStats solve(std::vector<Vec3>& x, const std::vector<char>& held,
+                              const std::vector<int>& handles, const std::vector<Vec3>& targets,
+                              double target, double bound, int maxIterations) const;
   std::vector<std::array<int, 2>> edges_;
   std::vector<double> rest_;
   std::vector<int> used_;  // vertices in some triangle
@@ -117,6 +141,9 @@ struct StrainLimitStats {
   bool carried = false;  // the carried start gave the result
   double lag = 0.0;      // the largest distance of a handle from its target (m)
   int lagVertex = -1;    // that handle's vertex, or -1
+  // Every handle's distance from its target (m), in StrainLimitInput order:
+  // (vertex, lag).
+  std::vector<std::pair<int, double>> handleLags;
 };
 
 // Leaves `positions` within `bound` whenever the step's start was, holding
