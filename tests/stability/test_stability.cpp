@@ -141,6 +141,27 @@ double reportedLag(const fs::path& summary) {
   return std::regex_search(text, m, lag) ? std::stod(m[1]) : 0.0;
 }
 
+// The summary's per-handle lags (crumpling.handle_lags) must account for
+// its largest lag: some handle is named with exactly that lag, none with
+// more.
+void checkHandleLags(const fs::path& summary, Outcome& o) {
+  const double largest = reportedLag(summary);
+  if (largest <= 1e-6) return;
+  const std::string text = readFile(summary);
+  static const std::regex each(
+      "\"handle\":\"[^\"]+\",\"frames\":[0-9]+,\"first_frame\":[0-9]+,"
+      "\"max_lag\":([-+0-9.eE]+)");
+  double most = 0.0;
+  int named = 0;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), each); it != std::sregex_iterator();
+       ++it, ++named)
+    most = std::max(most, std::stod((*it)[1]));
+  if (named == 0 || most != largest)
+    o.problems.push_back("summary: crumpling.handle_lags (" + std::to_string(named) +
+                         " handles, largest " + sci(most) + " m) does not give max_handle_lag " +
+                         sci(largest) + " m");
+}
+
 // Checks every cached frame: finite positions, mesh::validate, no degenerate
 // triangle, and the bounds (the handle error beyond the reported lag).
 void checkCache(const fs::path& cache, const Bounds& bounds, double lag, Outcome& o) {
@@ -242,6 +263,7 @@ TEST_P(Stability, EndsFiniteValidAndBoundedOrWithAClearError) {
   o.status = r.status;
   o.output = r.output;
   checkCache(tmp / "out" / "cache.pcache", bounds, reportedLag(tmp / "out" / "summary.json"), o);
+  checkHandleLags(tmp / "out" / "summary.json", o);
   appendRow(c.name, hybrid, o);
   RecordProperty("frames", static_cast<int>(o.frames));
   RecordProperty("end", endState(o));

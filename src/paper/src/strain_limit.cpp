@@ -395,8 +395,8 @@ StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
     return finish(std::move(best));
   }
   // 3a. Each handle as near its target as the bound lets it
-  // (projectTowards), from the carried start and from the stepped sheet:
-  // the candidate within the bound with the least summed squared lag.
+  // (projectTowards) from the carried start. (Started from the stepped sheet
+  // as well, it never gave the better result on crumple and cost 37 % more.)
   {
     const std::vector<char> none(in.pattern.size(), 0);
     const auto sumLag = [&](const std::vector<Vec3>& p) {
@@ -405,22 +405,13 @@ StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
         sum += (p[at(in.handles[h])] - in.targets[h]).squaredNorm();
       return sum;
     };
-    std::vector<Vec3> chosen;
-    double chosenLag = std::numeric_limits<double>::infinity();
-    for (const std::vector<Vec3>* from : {&feasible, &x}) {
-      std::vector<Vec3> trial = *from;
-      stats = projector.projectTowards(trial, none, in.handles, in.targets, in.bound,
-                                       kTowardsIterations);
-      s.iterations += stats.iterations;
-      if (stats.maxAfter > in.bound) continue;
-      if (const double lag = sumLag(trial); lag < chosenLag) {
-        chosenLag = lag;
-        chosen = std::move(trial);
-      }
-    }
-    if (!chosen.empty() && chosenLag < sumLag(feasible)) {
+    std::vector<Vec3> towards = feasible;
+    stats = projector.projectTowards(towards, none, in.handles, in.targets, in.bound,
+                                     kTowardsIterations);
+    s.iterations += stats.iterations;
+    if (stats.maxAfter <= in.bound && sumLag(towards) < sumLag(feasible)) {
       s.carried = true;
-      return finish(std::move(chosen));
+      return finish(std::move(towards));
     }
   }
   // 3b. Else all handles on the way from their carried positions to their

@@ -17,12 +17,11 @@
 //     reaches configurations the stepped sheet cannot.
 //  3. Lag: when neither start meets the bound with the handles on their
 //     targets, each handle is brought as near its target as the bound lets
-//     it (LengthProjector::projectTowards, from the carried start and from
-//     the stepped sheet), so one handle that cannot follow does not hold
-//     the others back. Failing that, the handles are held together on the
-//     segment from their carried positions (alpha = 0, lengths exact) to
-//     their targets (alpha = 1), at the largest alpha found by bisection
-//     that meets the bound. The handle rig pulls them on at the next step.
+//     it (LengthProjector::projectTowards, from the carried start), so one
+//     handle that cannot follow does not hold the others back. Failing that, the handles are held
+//     together on the segment from their carried positions (alpha = 0, lengths exact) to their
+//     targets (alpha = 1), at the largest alpha found by bisection that meets the bound. The handle
+//     rig pulls them on at the next step.
 #include <array>
 #include <utility>
 #include <vector>
