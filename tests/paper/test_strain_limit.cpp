@@ -264,6 +264,13 @@ TEST(LengthProjector, TowardsTargetsWithinTheBound) {
   EXPECT_LT(reach, 0.0099);
 }
 
+TEST(LimitStrain, MergesAFramesHandleLagsByTheirLargest) {
+  std::vector<std::pair<int, double>> frame{{3, 0.002}, {7, 0.0}};
+  mergeHandleLags({{7, 0.001}, {3, 0.001}, {9, 0.004}}, frame);
+  const std::vector<std::pair<int, double>> expected{{3, 0.002}, {7, 0.001}, {9, 0.004}};
+  EXPECT_EQ(frame, expected);
+}
+
 TEST(LimitStrain, ARebuiltSheetIsCarriedByPattern) {
   // The step's start is a coarser mesh of the same pattern: the carried start
   // interpolates it.

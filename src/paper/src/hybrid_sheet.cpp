@@ -75,16 +75,7 @@ void accumulate(HybridStepStats& total, const HybridStepStats& s) {
       total.strainLimit.lag = before.lag;
       total.strainLimit.lagVertex = before.lagVertex;
     }
-    // Each handle's largest lag over the frame's steps.
-    for (const auto& [vertex, lag] : before.handleLags) {
-      auto it =
-          std::find_if(total.strainLimit.handleLags.begin(), total.strainLimit.handleLags.end(),
-                       [v = vertex](const auto& e) { return e.first == v; });
-      if (it == total.strainLimit.handleLags.end())
-        total.strainLimit.handleLags.emplace_back(vertex, lag);
-      else
-        it->second = std::max(it->second, lag);
-    }
+    mergeHandleLags(before.handleLags, total.strainLimit.handleLags);
     total.strainLimitRuns += s.strainLimit.ran ? 1 : 0;
     total.strainLimitCarried += s.strainLimit.carried ? 1 : 0;
   }

@@ -312,6 +312,18 @@ void placeHandles(std::vector<Vec3>& x, const std::vector<int>& handles,
 
 }  // namespace
 
+void mergeHandleLags(const std::vector<std::pair<int, double>>& from,
+                     std::vector<std::pair<int, double>>& into) {
+  for (const auto& [vertex, lag] : from) {
+    auto it = std::find_if(into.begin(), into.end(),
+                           [v = vertex](const auto& e) { return e.first == v; });
+    if (it == into.end())
+      into.emplace_back(vertex, lag);
+    else
+      it->second = std::max(it->second, lag);
+  }
+}
+
 StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
   StrainLimitStats s;
   const LengthProjector projector(in.pattern, in.triangles);

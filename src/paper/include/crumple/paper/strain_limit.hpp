@@ -145,6 +145,11 @@ struct StrainLimitStats {
   std::vector<std::pair<int, double>> handleLags;
 };
 
+// Each handle's larger lag of `from` and `into`, into `into` (handles of
+// `from` that `into` lacks are appended): a frame's lags over its steps.
+void mergeHandleLags(const std::vector<std::pair<int, double>>& from,
+                     std::vector<std::pair<int, double>>& into);
+
 // Leaves `positions` within `bound` whenever the step's start was, holding
 // the handles on their targets if some start allows it and lagging them
 // otherwise; never raises the max strain it was given.
