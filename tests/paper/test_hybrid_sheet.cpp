@@ -131,10 +131,13 @@ TEST(HybridSheet, Deterministic) {
 // Issue 6: a tear cuts S_G (HybridSheet::tear) and the model goes on with
 // the torn sheet. The two bottom corners are drawn apart: S_G stays valid
 // at every sub-step (checkInvariants), the lips at the slit's mouth open in
-// 3D, and the tip stays an S_G vertex on the outline. (The corners end 1.4 L
-// apart while the sheet reaches 1.28 L around the slit's tip: with the
-// strain limit on, the handles lag and the mouth opens 7.3 mm, not > 10.)
+// 3D, and the tip stays an S_G vertex on the outline. The corners end
+// 1.24 L apart, within the 1.28 L the sheet reaches around the slit's tip,
+// and the top corners are free: drawn 1.4 L apart with the top corners
+// held, the strain limit (on by default) makes them lag and the mouth opens
+// 4.4 mm.
 TEST(HybridSheet, ATornSheetGoesOnAndItsLipsOpen) {
+  constexpr double kPull = 0.12;  // each corner's move, in sheet lengths
   const std::vector<Vec2> corners{Vec2(0, 0), Vec2(kL, 0), Vec2(kL, kL), Vec2(0, kL)};
   InitialSheet sheet = makeFlatSheet(kL, kL, corners, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
   HybridSheet hybrid(sheet.mesh, sim::Material{}, weightless(), checked(), 1);
@@ -147,10 +150,10 @@ TEST(HybridSheet, ATornSheetGoesOnAndItsLipsOpen) {
   EXPECT_EQ(validate(hybrid.geometric()), "");
   const auto pins = [&](double t, std::vector<sim::Pin>& out) {
     out.clear();
-    for (std::size_t k = 0; k < sheet.handleVertices.size(); ++k) {
+    for (std::size_t k = 0; k < 2; ++k) {  // the bottom corners only
       const int v = sheet.handleVertices[k];
       Vec3 x = sheet.mesh.vertices[static_cast<std::size_t>(v)].position;
-      if (k < 2) x.x() += (k == 0 ? -1.0 : 1.0) * 0.2 * kL * std::min(1.0, t / 0.2);
+      x.x() += (k == 0 ? -1.0 : 1.0) * kPull * kL * std::min(1.0, t / 0.2);
       out.push_back({v, x});
     }
   };

@@ -1,6 +1,7 @@
 #pragma once
 // Simulating a sample in a scene-level test (tests/pipeline): quietly,
 // without rendering, into a temporary folder.
+#include <functional>
 #include <string>
 
 #include "crumple/io/scene.hpp"
@@ -11,8 +12,10 @@ namespace crumple::testing {
 
 // Simulates samples/SAMPLE into dir/SAMPLE (up to frame `last` when >= 0);
 // returns its cache's path.
-inline std::string simulateSample(const std::string& sample, const TempDir& dir, int last = -1) {
-  const io::SceneSpec scene = io::loadScene(io::resolveScenePath(sourcePath("samples/" + sample)));
+inline std::string simulateSample(const std::string& sample, const TempDir& dir, int last = -1,
+                                  const std::function<void(io::SceneSpec&)>& edit = {}) {
+  io::SceneSpec scene = io::loadScene(io::resolveScenePath(sourcePath("samples/" + sample)));
+  if (edit) edit(scene);
   pipeline::ShotOptions options;
   options.outDir = (dir / sample).string();
   options.render = false;

@@ -116,7 +116,12 @@ double spectralCentroid(const std::vector<float>& x, int rate) {
 TEST(SoundSamples, WiggleFlapsAndACrumpledSheetClacs) {
   const TempDir dir;
   const CachedEvents wiggle = readEvents(simulateSample("wiggle", dir));
-  const CachedEvents crumple = readEvents(simulateSample("crumple", dir));
+  // With its strain limit on (the default) the squeezed sheet stands still
+  // from frame 32 while its handles lag (docs/CRUMPLING.md, "Strain limit")
+  // and makes 2 crumpling events after 2 s; the census needs a sheet that
+  // goes on crumpling, so this shot runs without the limit.
+  const CachedEvents crumple = readEvents(simulateSample(
+      "crumple", dir, -1, [](io::SceneSpec& s) { s.model.hybrid.maxEdgeStrain = 0.0; }));
   const Census w = crumplingCensus(wiggle);
   // The crumple sample once it is crumpled: from 2 s, when its corners
   // fold and its singular vertices have appeared.

@@ -233,7 +233,7 @@ struct HybridSpec {
   double isometryLengthTolerance = 1e-6;   // their early exit: worst relative edge error
   int maxSingularPerFrame = 2;             // new singular vertices per frame at most
   int remeshCooldown = 3;                  // animation steps a remeshed region waits
-  double maxEdgeStrain = 0.0;              // S_P's strain bound after every step (0: off)
+  double maxEdgeStrain = 0.02;             // S_P's strain bound after every step (0: off)
 };
 
 struct ModelSpec {

@@ -72,10 +72,9 @@ struct CrumpleParams {
   int maxSingularPerFrame = 2;
   // Paper stays paper: after every animation step S_P's max relative edge
   // strain is at most this, the handles lagging when no configuration with
-  // them on their targets meets it (strain_limit.hpp). 0, the default, turns
-  // it off: on the crumple and tear-cylinder samples it does not yet help
-  // (docs/CRUMPLING.md, "Strain limit"); 0.02 is the paper-stays-paper bound.
-  double maxEdgeStrain = 0.0;
+  // them on their targets meets it (strain_limit.hpp). 0 turns it off
+  // (docs/CRUMPLING.md, "Strain limit").
+  double maxEdgeStrain = 0.02;
   int strainLimitIterations = 30;  // Levenberg-Marquardt steps per projection
 #ifdef NDEBUG
   bool checkInvariants = false;  // validate S_G and S_P after every geometric step
