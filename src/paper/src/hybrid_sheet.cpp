@@ -18,6 +18,7 @@
 #include "crumple/paper/cone_fit.hpp"
 #include "crumple/paper/damage.hpp"
 #include "crumple/sim/colliders.hpp"
+#include "hybrid_sheet_impl.hpp"
 #include "region_tools.hpp"
 #include "step_trace.hpp"
 
@@ -25,15 +26,9 @@ namespace crumple::paper {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
-bool allFinite(const std::vector<Vec3>& v) {
-  return std::all_of(v.begin(), v.end(), [](const Vec3& x) { return x.allFinite(); });
-}
+using detail::allFinite;
+using detail::Clock;
+using detail::msSince;
 
 // Sums the stats of the animation steps of one frame.
 void accumulate(HybridStepStats& total, const HybridStepStats& s) {
@@ -87,128 +82,6 @@ void accumulate(HybridStepStats& total, const HybridStepStats& s) {
 }
 
 }  // namespace
-
-struct HybridSheet::Impl {
-  GeometricMesh sg;
-  PhysicalMesh sp;
-  sim::Material material;
-  sim::SimParams simParams;
-  CrumpleParams params;
-  std::uint64_t seed = 1;
-  std::optional<sim::ElasticSheet> elastic;
-  std::optional<IsometryProjector> isometry;
-  std::vector<Vec3> spVelocities;
-  double paperLength = 0.0;
-  std::function<void(const mesh::SheetMesh&, double)> onRebuild;
-  std::function<void(const ProjectionInput&)> onProjection;  // paper Table III inputs
-  // The isometry projection's options from the parameters (paper Sec. 6.3).
-  IsometryOptions isometryOptions() const {
-    IsometryOptions iso;
-    iso.rounds = params.isometryRounds;
-    iso.lengthSweeps = params.isometryLengthSweeps;
-    iso.lengthTolerance = params.isometryLengthTolerance;
-    return iso;
-  }
-  double time = 0.0;            // time S_G and S_P are at
-  sim::ContactOptions contact;  // issue 5
-  std::vector<sim::ContactSample> contacts;
-  bool contactsOn() const {
-    return (contact.colliders != nullptr && contact.colliders->size() > 0) ||
-           contact.self != sim::SelfContactMode::Off;
-  }
-  // Where compression was treated in the last remeshCooldown steps, and how
-  // many more steps each point blocks remeshing of the region holding it.
-  std::vector<std::pair<Vec2, int>> recentCuts;
-
-  // Whether face f holds a recent cut (at one of its vertices or inside it).
-  bool holdsRecentCut(const GeometricFace& f) const {
-    const std::span<const int> corners(f.v.data(), static_cast<std::size_t>(f.size()));
-    for (const auto& [p, left] : recentCuts) {
-      for (int v : corners) {
-        if ((sg.vertices[static_cast<std::size_t>(v)].pattern - p).norm() < 1e-9) return true;
-      }
-      if (detail::pointInPolygon(sg, corners, p)) return true;
-    }
-    return false;
-  }
-
-  // S_P from S_G (paper Sec. 4, Fig. 16 (g)) with fiber damage (thesis 2.3.3).
-  // Returns true when the connectivity or pattern changed.
-  bool rebuildPhysical() {
-    PhysicalMesh next = buildPhysicalMesh(sg, params);
-    updateSamples(next, sg, &spVelocities);
-    const bool same = elastic.has_value() && next.mesh.triangles == sp.mesh.triangles &&
-                      next.mesh.pattern == sp.mesh.pattern;
-    sp = std::move(next);
-    if (!same) {
-      elastic.emplace(sp.mesh, material, simParams);
-      elastic->setContacts(contact);
-    } else {
-      elastic->setPositions(sp.mesh.positions);
-    }
-    elastic->setVelocities(spVelocities);
-    // Damage: rest angles and weakened bending around singular vertices.
-    std::vector<char> singular(sp.mesh.vertexCount(), 0);
-    for (std::size_t v = 0; v < sg.vertices.size(); ++v)
-      singular[v] = sg.vertices[v].singular ? 1 : 0;
-    const auto& hinges = elastic->hinges();
-    std::vector<double> angles(hinges.size());
-    for (std::size_t h = 0; h < hinges.size(); ++h) angles[h] = elastic->hingeAngle(h);
-    const auto damage = fiberDamage(sp.mesh, hinges, singular, angles, params);
-    const std::vector<double> sliver = sliverHingeFactors(sp.mesh, hinges, params.sliverHingeRatio);
-    for (std::size_t h = 0; h < hinges.size(); ++h) {
-      elastic->setHingeRestAngle(h, damage[h].restAngle);
-      elastic->setHingeStiffnessFactor(h, damage[h].stiffnessFactor * sliver[h]);
-    }
-    if (onRebuild) onRebuild(sp.mesh, time);
-    return !same;
-  }
-
-  // Developer trace (CRUMPLE_DEBUG_GEOMETRY, step_trace.hpp) and the largest
-  // S_P hinge angle after the elastic step, the rebuild and the isometry.
-  int traceLevel = detail::stepTraceLevel();
-  std::array<double, 3> traceHinge{};
-  double traceElasticStrain = 0.0;  // max |r_e| of S_P as the elastic step left it
-  void noteHinge(int stage) {
-    if (traceLevel > 0)
-      traceHinge[static_cast<std::size_t>(stage)] = detail::maxHingeAngle(*elastic);
-  }
-
-  void limitStepStrain(const mesh::SheetMesh& spBefore, const GeometricMesh& sgBefore,
-                       const std::vector<sim::Pin>& pinned, int frame, std::vector<Vec3>& positions,
-                       HybridStepStats& stats);
-  void animationStep(double t, double dt, const sim::PinFunction& pins, int frame,
-                     int singularBudget, std::uint64_t& draw, HybridStepStats& stats,
-                     const char*& stage);
-
-  // The elastic step's contacts, carried to the current S_P by pattern.
-  void carryContacts(const std::vector<sim::ContactSample>& samples,
-                     const std::vector<Vec2>& patternBefore);
-
-  void checkInvariants(int frame, const char* stage) const {
-    const std::string problem = validate(sg, params.theta0);
-    if (!problem.empty()) throw NumericalError(stage, frame, "S_G invariant broken: " + problem);
-    if (sp.geometricVertexCount() != sg.vertexCount()) {
-      throw NumericalError(stage, frame, "S_P does not hold every S_G vertex");
-    }
-    const std::string mp = mesh::validate(sp.mesh);
-    if (!mp.empty()) throw NumericalError(stage, frame, "S_P invalid: " + mp);
-    double area = 0.0;
-    for (const auto& t : sp.mesh.triangles) {
-      const Vec2 a = sp.mesh.pattern[static_cast<std::size_t>(t[1])] -
-                     sp.mesh.pattern[static_cast<std::size_t>(t[0])];
-      const Vec2 b = sp.mesh.pattern[static_cast<std::size_t>(t[2])] -
-                     sp.mesh.pattern[static_cast<std::size_t>(t[0])];
-      area += 0.5 * (a.x() * b.y() - a.y() * b.x());
-    }
-    const double sheet = outlineArea(sg);
-    if (std::abs(area - sheet) > 1e-9 * sheet) {
-      std::ostringstream msg;
-      msg << "S_P covers " << area << " m^2 of the " << sheet << " m^2 sheet";
-      throw NumericalError(stage, frame, msg.str());
-    }
-  }
-};
 
 void HybridSheet::Impl::carryContacts(const std::vector<sim::ContactSample>& samples,
                                       const std::vector<Vec2>& patternBefore) {
@@ -484,60 +357,6 @@ int HybridSheet::interiorSingularVertexCount() const {
                     [](const GeometricVertex& v) { return v.singular && !v.onBoundary; }));
 }
 
-// Paper stays paper after the isometry (strain_limit.hpp): S_P within
-// maxEdgeStrain, the handles on their targets or lagging; a remeshing that
-// leaves no configuration within the bound is undone.
-void HybridSheet::Impl::limitStepStrain(const mesh::SheetMesh& spBefore,
-                                        const GeometricMesh& sgBefore,
-                                        const std::vector<sim::Pin>& pinned, int frame,
-                                        std::vector<Vec3>& positions, HybridStepStats& stats) {
-  Impl& m = *this;
-  // The handle vertices and their targets (tangent-plane pins bind in the
-  // elastic step only).
-  std::vector<int> handles, tangentPins;
-  std::vector<Vec3> targets;
-  for (const sim::Pin& p : pinned) {
-    const auto v = static_cast<std::size_t>(p.vertex);
-    if (v < positions.size() && (v >= m.sg.vertices.size() || !m.sg.vertices[v].handle))
-      tangentPins.push_back(p.vertex);
-    if (v >= m.sg.vertices.size() || !m.sg.vertices[v].handle || v >= spBefore.positions.size())
-      continue;
-    handles.push_back(p.vertex);
-    targets.push_back(p.position);
-  }
-  const auto limit = [&] {
-    const bool sameMesh =
-        spBefore.triangles == m.sp.mesh.triangles && spBefore.pattern == m.sp.mesh.pattern;
-    return limitStrain({m.sp.mesh.pattern, m.sp.mesh.triangles, spBefore.pattern,
-                        spBefore.triangles, spBefore.positions, sameMesh, handles, targets,
-                        tangentPins, m.params.maxEdgeStrain, m.params.strainLimitIterations},
-                       positions);
-  };
-  stats.strainLimit = limit();
-  if (stats.strainLimit.maxAfter > m.params.maxEdgeStrain && stats.topologyChanged &&
-      spBefore.positions.size() >= m.sg.vertices.size()) {
-    // The new structure leaves S_P no configuration within the bound from
-    // any start, while the step's start was within it: the step's remeshing
-    // is undone (transactional, like the cone fits above) and the sheet as
-    // it was lags instead; the cooldown keeps the region from being remeshed
-    // again at once.
-    m.sg = sgBefore;
-    m.rebuildPhysical();
-    if (m.sp.mesh.triangles == spBefore.triangles && m.sp.mesh.pattern == spBefore.pattern) {
-      positions = spBefore.positions;
-      for (std::size_t h = 0; h < handles.size(); ++h)
-        positions[static_cast<std::size_t>(handles[h])] = targets[h];
-      const int iterations = stats.strainLimit.iterations;
-      stats.strainLimit = limit();
-      stats.strainLimit.iterations += iterations;
-      stats.geometric.notes.push_back(
-          "the step's remeshing undone: S_P had no configuration "
-          "within max_edge_strain");
-    }
-  }
-  if (!allFinite(positions)) throw NumericalError("strain limit", frame, "non-finite positions");
-}
-
 // One animation step of the paper (Fig. 16, thesis Algorithm 1) from t to
 // t + dt: an elastic step of S_P, S_P -> S_G, the geometric step, cone
 // fitting, S_P rebuilt from S_G, the isometry projection and (with
@@ -724,12 +543,8 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
   }
   if (m.contactsOn()) {
     stage = "contacts";
-    std::vector<char> held(m.sp.mesh.vertexCount(), 0);
-    for (const sim::Pin& p : pinned)
-      if (static_cast<std::size_t>(p.vertex) < held.size())
-        held[static_cast<std::size_t>(p.vertex)] = 1;
-    sim::projectOutOfContacts(m.contact, m.sp.mesh.triangles, m.sp.mesh.pattern, held, positions,
-                              &stats.ms.contacts, &stats.ms.selfContacts);
+    sim::projectOutOfContacts(m.contact, m.sp.mesh.triangles, m.sp.mesh.pattern, m.heldBy(pinned),
+                              positions, &stats.ms.contacts, &stats.ms.selfContacts);
     const auto carryStart = Clock::now();
     m.carryContacts(elasticContacts, elasticPattern);
     stats.ms.contacts += msSince(carryStart);

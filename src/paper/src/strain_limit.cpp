@@ -95,8 +95,13 @@ LengthProjectionStats LengthProjector::solve(std::vector<Vec3>& x, const std::ve
   const auto weight = [&](double r) {
     return bound > 0.0 && std::abs(r) > soft ? 1.0 + kBoundWeight : 1.0;
   };
+  const double keepWeight = kHandleWeight / (meanRest * meanRest);
+  const auto inside = [&](const KeepOut& k, const std::vector<Vec3>& p) {
+    return std::min(0.0, k.normal.dot(p[at(k.vertex)] - k.point));
+  };
   const auto cost = [&](const std::vector<Vec3>& p) {
     double s = 0.0;
+    for (const KeepOut& k : keepOut_) s += keepWeight * inside(k, p) * inside(k, p);
     for (std::size_t k = 0; k < edges_.size(); ++k) {
       const double r = ((p[at(edges_[k][1])] - p[at(edges_[k][0])]).norm() - rest_[k]) / rest_[k];
       s += r * r + (weight(r) - 1.0) * (std::abs(r) - soft) * (std::abs(r) - soft);
@@ -155,6 +160,15 @@ LengthProjectionStats LengthProjector::solve(std::vector<Vec3>& x, const std::ve
       if (c < 0) continue;
       g.segment<3>(3 * c) += handleWeight * (x[at(handles[h])] - targets[h]);
       for (int p = 0; p < 3; ++p) triplets.emplace_back(3 * c + p, 3 * c + p, handleWeight);
+    }
+    for (const KeepOut& k : keepOut_) {
+      const int c = k.vertex >= 0 && at(k.vertex) < vertexCount_ ? column[at(k.vertex)] : -1;
+      const double s = c < 0 ? 0.0 : inside(k, x);
+      if (s == 0.0) continue;
+      g.segment<3>(3 * c) += keepWeight * s * k.normal;
+      const Mat3 block = keepWeight * k.normal * k.normal.transpose();
+      for (int p = 0; p < 3; ++p)
+        for (int q = 0; q < 3; ++q) triplets.emplace_back(3 * c + p, 3 * c + q, block(p, q));
     }
     H.setFromTriplets(triplets.begin(), triplets.end());
     const Eigen::VectorXd diag = H.diagonal();
@@ -326,7 +340,8 @@ void mergeHandleLags(const std::vector<std::pair<int, double>>& from,
 
 StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
   StrainLimitStats s;
-  const LengthProjector projector(in.pattern, in.triangles);
+  LengthProjector projector(in.pattern, in.triangles);
+  projector.setKeepOut(in.keepOut);
   std::tie(s.maxBefore, s.meanAfter) = projector.strain(x);
   s.maxAfter = s.maxBefore;
   const auto finish = [&](std::vector<Vec3> chosen) {
@@ -447,6 +462,21 @@ StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
   }
   s.carried = true;
   return finish(std::move(feasible));
+}
+
+std::vector<KeepOut> keepOutOfContacts(const sim::ContactOptions& options,
+                                       const std::vector<std::array<int, 3>>& triangles,
+                                       const std::vector<Vec2>& pattern,
+                                       const std::vector<char>& held, std::vector<Vec3>& x,
+                                       double* collidersMs, double* selfMs) {
+  const std::vector<Vec3> before = x;
+  sim::projectOutOfContacts(options, triangles, pattern, held, x, collidersMs, selfMs);
+  std::vector<KeepOut> out;
+  for (std::size_t v = 0; v < x.size(); ++v) {
+    const Vec3 moved = x[v] - before[v];
+    if (moved.norm() > 0.0) out.push_back({static_cast<int>(v), x[v], moved.normalized()});
+  }
+  return out;
 }
 
 }  // namespace crumple::paper

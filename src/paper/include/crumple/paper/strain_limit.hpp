@@ -27,8 +27,19 @@
 #include <vector>
 
 #include "crumple/core/types.hpp"
+#include "crumple/sim/elastic_sheet.hpp"
 
 namespace crumple::paper {
+
+// A contact as a constraint of the projection: `vertex` stays on the side
+// of the plane through `point` that `normal` (unit) points to. The contact
+// failsafe's move of a vertex out of a collider or another layer gives one
+// (its new position and direction), linearised where it acted.
+struct KeepOut {
+  int vertex = -1;
+  Vec3 point = Vec3::Zero();
+  Vec3 normal = Vec3::UnitZ();
+};
 
 struct LengthProjectionStats {
   double maxBefore = 0.0, maxAfter = 0.0;    // max |r_e|
@@ -78,6 +89,11 @@ class LengthProjector {
 
   [[nodiscard]] std::size_t edgeCount() const { return edges_.size(); }
 
+  // Contacts every projection keeps (a penalty (kHandleWeight / l^2)
+  // min(0, n . (x_v - p))^2 per KeepOut, l the mean rest length): the
+  // strain limit then works with the contact failsafe, not against it.
+  void setKeepOut(std::vector<KeepOut> keepOut) { keepOut_ = std::move(keepOut); }
+
  private:
   LengthProjectionStats solve(std::vector<Vec3>& x, const std::vector<char>& held,
                               const std::vector<int>& handles, const std::vector<Vec3>& targets,
@@ -85,6 +101,7 @@ class LengthProjector {
   std::vector<std::array<int, 2>> edges_;
   std::vector<double> rest_;
   std::vector<int> used_;  // vertices in some triangle
+  std::vector<KeepOut> keepOut_;
   std::size_t vertexCount_ = 0;
 };
 
@@ -129,6 +146,9 @@ struct StrainLimitInput {
   const std::vector<int>& pins;
   double bound = 0.02;  // max |r_e| accepted
   int iterations = 30;  // Levenberg-Marquardt steps per projection
+  // Contacts the projections keep (LengthProjector::setKeepOut); the
+  // positions given are already out of them.
+  std::vector<KeepOut> keepOut = {};
 };
 
 struct StrainLimitStats {
@@ -149,6 +169,15 @@ struct StrainLimitStats {
 // `from` that `into` lacks are appended): a frame's lags over its steps.
 void mergeHandleLags(const std::vector<std::pair<int, double>>& from,
                      std::vector<std::pair<int, double>>& into);
+
+// The contact failsafe (sim::projectOutOfContacts) on `x`, as the
+// constraints it imposed: each vertex it moved, at its new position, with
+// the direction it moved in. `held` vertices stay (the handles and pins).
+std::vector<KeepOut> keepOutOfContacts(const sim::ContactOptions& options,
+                                       const std::vector<std::array<int, 3>>& triangles,
+                                       const std::vector<Vec2>& pattern,
+                                       const std::vector<char>& held, std::vector<Vec3>& x,
+                                       double* collidersMs, double* selfMs);
 
 // Leaves `positions` within `bound` whenever the step's start was, holding
 // the handles on their targets if some start allows it and lagging them

@@ -1,0 +1,173 @@
+#pragma once
+// The state of paper::HybridSheet (its pimpl), shared by the files that
+// implement it: hybrid_sheet.cpp (the animation step, paper Fig. 16) and
+// hybrid_strain_limit.cpp (paper stays paper after it).
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <span>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "crumple/core/error.hpp"
+#include "crumple/core/geometry2d.hpp"
+#include "crumple/paper/damage.hpp"
+#include "crumple/paper/hybrid_sheet.hpp"
+#include "crumple/sim/colliders.hpp"
+#include "region_tools.hpp"
+#include "step_trace.hpp"
+
+namespace crumple::paper {
+
+namespace detail {
+
+using Clock = std::chrono::steady_clock;
+
+inline double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+inline bool allFinite(const std::vector<Vec3>& v) {
+  return std::all_of(v.begin(), v.end(), [](const Vec3& x) { return x.allFinite(); });
+}
+
+}  // namespace detail
+
+struct HybridSheet::Impl {
+  GeometricMesh sg;
+  PhysicalMesh sp;
+  sim::Material material;
+  sim::SimParams simParams;
+  CrumpleParams params;
+  std::uint64_t seed = 1;
+  std::optional<sim::ElasticSheet> elastic;
+  std::optional<IsometryProjector> isometry;
+  std::vector<Vec3> spVelocities;
+  double paperLength = 0.0;
+  std::function<void(const mesh::SheetMesh&, double)> onRebuild;
+  std::function<void(const ProjectionInput&)> onProjection;  // paper Table III inputs
+  // The isometry projection's options from the parameters (paper Sec. 6.3).
+  IsometryOptions isometryOptions() const {
+    IsometryOptions iso;
+    iso.rounds = params.isometryRounds;
+    iso.lengthSweeps = params.isometryLengthSweeps;
+    iso.lengthTolerance = params.isometryLengthTolerance;
+    return iso;
+  }
+  double time = 0.0;            // time S_G and S_P are at
+  sim::ContactOptions contact;  // issue 5
+  std::vector<sim::ContactSample> contacts;
+  bool contactsOn() const {
+    return (contact.colliders != nullptr && contact.colliders->size() > 0) ||
+           contact.self != sim::SelfContactMode::Off;
+  }
+  // Where compression was treated in the last remeshCooldown steps, and how
+  // many more steps each point blocks remeshing of the region holding it.
+  std::vector<std::pair<Vec2, int>> recentCuts;
+
+  // Whether face f holds a recent cut (at one of its vertices or inside it).
+  bool holdsRecentCut(const GeometricFace& f) const {
+    const std::span<const int> corners(f.v.data(), static_cast<std::size_t>(f.size()));
+    for (const auto& [p, left] : recentCuts) {
+      for (int v : corners) {
+        if ((sg.vertices[static_cast<std::size_t>(v)].pattern - p).norm() < 1e-9) return true;
+      }
+      if (detail::pointInPolygon(sg, corners, p)) return true;
+    }
+    return false;
+  }
+
+  // S_P from S_G (paper Sec. 4, Fig. 16 (g)) with fiber damage (thesis 2.3.3).
+  // Returns true when the connectivity or pattern changed.
+  bool rebuildPhysical() {
+    PhysicalMesh next = buildPhysicalMesh(sg, params);
+    updateSamples(next, sg, &spVelocities);
+    const bool same = elastic.has_value() && next.mesh.triangles == sp.mesh.triangles &&
+                      next.mesh.pattern == sp.mesh.pattern;
+    sp = std::move(next);
+    if (!same) {
+      elastic.emplace(sp.mesh, material, simParams);
+      elastic->setContacts(contact);
+    } else {
+      elastic->setPositions(sp.mesh.positions);
+    }
+    elastic->setVelocities(spVelocities);
+    // Damage: rest angles and weakened bending around singular vertices.
+    std::vector<char> singular(sp.mesh.vertexCount(), 0);
+    for (std::size_t v = 0; v < sg.vertices.size(); ++v)
+      singular[v] = sg.vertices[v].singular ? 1 : 0;
+    const auto& hinges = elastic->hinges();
+    std::vector<double> angles(hinges.size());
+    for (std::size_t h = 0; h < hinges.size(); ++h) angles[h] = elastic->hingeAngle(h);
+    const auto damage = fiberDamage(sp.mesh, hinges, singular, angles, params);
+    const std::vector<double> sliver = sliverHingeFactors(sp.mesh, hinges, params.sliverHingeRatio);
+    for (std::size_t h = 0; h < hinges.size(); ++h) {
+      elastic->setHingeRestAngle(h, damage[h].restAngle);
+      elastic->setHingeStiffnessFactor(h, damage[h].stiffnessFactor * sliver[h]);
+    }
+    if (onRebuild) onRebuild(sp.mesh, time);
+    return !same;
+  }
+
+  // Developer trace (CRUMPLE_DEBUG_GEOMETRY, step_trace.hpp) and the largest
+  // S_P hinge angle after the elastic step, the rebuild and the isometry.
+  int traceLevel = detail::stepTraceLevel();
+  std::array<double, 3> traceHinge{};
+
+  double traceElasticStrain = 0.0;  // max |r_e| of S_P as the elastic step left it
+  void noteHinge(int stage) {
+    if (traceLevel > 0)
+      traceHinge[static_cast<std::size_t>(stage)] = detail::maxHingeAngle(*elastic);
+  }
+
+  void limitStepStrain(const mesh::SheetMesh& spBefore, const GeometricMesh& sgBefore,
+                       const std::vector<sim::Pin>& pinned, int frame, std::vector<Vec3>& positions,
+                       HybridStepStats& stats);
+  // The pinned vertices of S_P (1), which contacts leave where they are.
+  std::vector<char> heldBy(const std::vector<sim::Pin>& pinned) const {
+    std::vector<char> out(sp.mesh.vertexCount(), 0);
+    for (const sim::Pin& p : pinned)
+      if (static_cast<std::size_t>(p.vertex) < out.size())
+        out[static_cast<std::size_t>(p.vertex)] = 1;
+    return out;
+  }
+  void animationStep(double t, double dt, const sim::PinFunction& pins, int frame,
+                     int singularBudget, std::uint64_t& draw, HybridStepStats& stats,
+                     const char*& stage);
+
+  // The elastic step's contacts, carried to the current S_P by pattern.
+  void carryContacts(const std::vector<sim::ContactSample>& samples,
+                     const std::vector<Vec2>& patternBefore);
+
+  void checkInvariants(int frame, const char* stage) const {
+    const std::string problem = validate(sg, params.theta0);
+    if (!problem.empty()) throw NumericalError(stage, frame, "S_G invariant broken: " + problem);
+    if (sp.geometricVertexCount() != sg.vertexCount()) {
+      throw NumericalError(stage, frame, "S_P does not hold every S_G vertex");
+    }
+    const std::string mp = mesh::validate(sp.mesh);
+    if (!mp.empty()) throw NumericalError(stage, frame, "S_P invalid: " + mp);
+    double area = 0.0;
+    for (const auto& t : sp.mesh.triangles) {
+      const Vec2 a = sp.mesh.pattern[static_cast<std::size_t>(t[1])] -
+                     sp.mesh.pattern[static_cast<std::size_t>(t[0])];
+      const Vec2 b = sp.mesh.pattern[static_cast<std::size_t>(t[2])] -
+                     sp.mesh.pattern[static_cast<std::size_t>(t[0])];
+      area += 0.5 * (a.x() * b.y() - a.y() * b.x());
+    }
+    const double sheet = outlineArea(sg);
+    if (std::abs(area - sheet) > 1e-9 * sheet) {
+      std::ostringstream msg;
+      msg << "S_P covers " << area << " m^2 of the " << sheet << " m^2 sheet";
+      throw NumericalError(stage, frame, msg.str());
+    }
+  }
+};
+
+}  // namespace crumple::paper

@@ -1,0 +1,96 @@
+// Paper stays paper after every animation step of the crumpling model:
+// HybridSheet's strain-limit stage (strain_limit.hpp, docs/CRUMPLING.md
+// "Strain limit"), with the contacts as constraints it keeps.
+#include <vector>
+
+#include "crumple/core/error.hpp"
+#include "crumple/paper/strain_limit.hpp"
+#include "hybrid_sheet_impl.hpp"
+
+namespace crumple::paper {
+
+using detail::allFinite;
+
+// Paper stays paper after the isometry (strain_limit.hpp): S_P within
+// maxEdgeStrain, the handles on their targets or lagging; a remeshing that
+// leaves no configuration within the bound is undone.
+void HybridSheet::Impl::limitStepStrain(const mesh::SheetMesh& spBefore,
+                                        const GeometricMesh& sgBefore,
+                                        const std::vector<sim::Pin>& pinned, int frame,
+                                        std::vector<Vec3>& positions, HybridStepStats& stats) {
+  Impl& m = *this;
+  // The handle vertices and their targets (tangent-plane pins bind in the
+  // elastic step only).
+  std::vector<int> handles, tangentPins;
+  std::vector<Vec3> targets;
+  for (const sim::Pin& p : pinned) {
+    const auto v = static_cast<std::size_t>(p.vertex);
+    if (v < positions.size() && (v >= m.sg.vertices.size() || !m.sg.vertices[v].handle))
+      tangentPins.push_back(p.vertex);
+    if (v >= m.sg.vertices.size() || !m.sg.vertices[v].handle || v >= spBefore.positions.size())
+      continue;
+    handles.push_back(p.vertex);
+    targets.push_back(p.position);
+  }
+  std::vector<KeepOut> keepOut;  // the contacts the limit keeps
+  const auto limit = [&] {
+    const bool sameMesh =
+        spBefore.triangles == m.sp.mesh.triangles && spBefore.pattern == m.sp.mesh.pattern;
+    return limitStrain(
+        {m.sp.mesh.pattern, m.sp.mesh.triangles, spBefore.pattern, spBefore.triangles,
+         spBefore.positions, sameMesh, handles, targets, tangentPins, m.params.maxEdgeStrain,
+         m.params.strainLimitIterations, keepOut},
+        positions);
+  };
+  // Contacts as constraints of the limit: the failsafe's moves are kept
+  // (KeepOut), and failsafe and limit alternate while the failsafe breaks
+  // the bound again (alternating projections, von Neumann 1950).
+  const auto contactRound = [&] {
+    if (!m.contactsOn()) return false;
+    const auto more =
+        keepOutOfContacts(m.contact, m.sp.mesh.triangles, m.sp.mesh.pattern, m.heldBy(pinned),
+                          positions, &stats.ms.contacts, &stats.ms.selfContacts);
+    keepOut.insert(keepOut.end(), more.begin(), more.end());
+    return !more.empty();
+  };
+  const auto again = [&] {
+    const StrainLimitStats first = stats.strainLimit;
+    stats.strainLimit = limit();
+    stats.strainLimit.iterations += first.iterations;
+    stats.strainLimit.maxBefore = first.maxBefore;
+    stats.strainLimit.ran = stats.strainLimit.ran || first.ran;
+  };
+  contactRound();
+  stats.strainLimit = limit();
+  if (stats.strainLimit.maxAfter > m.params.maxEdgeStrain && stats.topologyChanged &&
+      spBefore.positions.size() >= m.sg.vertices.size()) {
+    // The new structure leaves S_P no configuration within the bound from
+    // any start, while the step's start was within it: the step's remeshing
+    // is undone (transactional, like the cone fits above) and the sheet as
+    // it was lags instead; the cooldown keeps the region from being remeshed
+    // again at once.
+    m.sg = sgBefore;
+    m.rebuildPhysical();
+    keepOut.clear();  // its vertices were the undone S_P's
+    if (m.sp.mesh.triangles == spBefore.triangles && m.sp.mesh.pattern == spBefore.pattern) {
+      positions = spBefore.positions;
+      for (std::size_t h = 0; h < handles.size(); ++h)
+        positions[static_cast<std::size_t>(handles[h])] = targets[h];
+      contactRound();
+      again();
+      stats.geometric.notes.push_back(
+          "the step's remeshing undone: S_P had no configuration "
+          "within max_edge_strain");
+    }
+  }
+  const LengthProjector lengths(m.sp.mesh.pattern, m.sp.mesh.triangles);
+  // Until the failsafe moves nothing (one pass can push a vertex out of one
+  // layer into another), the limit again wherever it broke the bound.
+  constexpr int kContactRounds = 8;
+  for (int round = 0; round < kContactRounds && contactRound(); ++round) {
+    if (lengths.strain(positions).first > m.params.maxEdgeStrain) again();
+  }
+  if (!allFinite(positions)) throw NumericalError("strain limit", frame, "non-finite positions");
+}
+
+}  // namespace crumple::paper
