@@ -81,6 +81,10 @@ void HybridSheet::Impl::limitStepStrain(const mesh::SheetMesh& spBefore,
       stats.geometric.notes.push_back(
           "the step's remeshing undone: S_P had no configuration "
           "within max_edge_strain");
+    } else {
+      // S_P came out of the step's S_G other than it was at the step's
+      // start: the sheet as rebuilt there, whose vertices `positions` are.
+      positions = m.sp.mesh.positions;
     }
   }
   const LengthProjector lengths(m.sp.mesh.pattern, m.sp.mesh.triangles);
