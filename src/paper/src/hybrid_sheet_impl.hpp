@@ -61,7 +61,7 @@ struct HybridSheet::Impl {
     return iso;
   }
   double time = 0.0;            // time S_G and S_P are at
-  sim::ContactOptions contact;  // issue 5
+  sim::ContactOptions contact;  // docs/CONTACTS.md "The crumpling model"
   std::vector<sim::ContactSample> contacts;
   bool contactsOn() const {
     return (contact.colliders != nullptr && contact.colliders->size() > 0) ||
