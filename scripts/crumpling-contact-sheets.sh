@@ -10,7 +10,9 @@
 # evenly spaced, labelled with their numbers). Extra scene lines for [model]
 # come from CRUMPLE_MODEL_LINES (e.g. "max_edge_strain = 0"); the images are
 # then named crumpling-<sample>-$CRUMPLE_VARIANT-<view>.png (default
-# variant name: custom).
+# variant name: custom). CRUMPLE_ELASTIC_EDGE=E (cm) runs the same motion on
+# the elastic model instead, on a fixed mesh of edge E, shaded only:
+# crumpling-<sample>-elastic-<E>cm-shaded.png (a reference to compare by eye).
 # Usage: scripts/crumpling-contact-sheets.sh [SAMPLE...]   (BUILD_DIR, default build)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -25,6 +27,12 @@ trap 'rm -rf "$tmp"' EXIT
 mkdir -p "$root/docs/images"
 suffix=""
 [ -n "${CRUMPLE_MODEL_LINES:-}" ] && suffix="-${CRUMPLE_VARIANT:-custom}"
+elastic="${CRUMPLE_ELASTIC_EDGE:-}"
+views=(shaded structure)
+if [ -n "$elastic" ]; then
+  suffix="-elastic-${elastic}cm"
+  views=(shaded)
+fi
 for sample in "${samples[@]}"; do
   src="$root/samples/$sample"
   [ -f "$src/scene.toml" ] || { echo "no sample $sample" >&2; exit 2; }
@@ -34,10 +42,14 @@ for sample in "${samples[@]}"; do
   if [ -n "${CRUMPLE_MODEL_LINES:-}" ]; then
     sed -i "s/^type = \"hybrid\".*/&\n${CRUMPLE_MODEL_LINES}/" "$work/scene.toml"
   fi
+  if [ -n "$elastic" ]; then
+    sed -i -e 's/^type = "hybrid".*/type = "elastic"/' \
+      -e "s/^\[sheet\]\$/[sheet]\nmax_edge = ${elastic}/" "$work/scene.toml"
+  fi
   echo "contact sheets: simulating $sample" >&2
   "$build/crumple" simulate "$work/scene.toml" --out "$work/out" >"$work/simulate.log" 2>&1 ||
     { cat "$work/simulate.log" >&2; exit 1; }
-  for view in shaded structure; do
+  for view in "${views[@]}"; do
     flags=(--contact-sheet --out "$work/frames-$view")
     [ "$view" = structure ] && flags+=(--debug-structure)
     "$build/crumple" render "$work/out/cache.pcache" "${flags[@]}" >"$work/render.log" 2>&1 ||

@@ -57,6 +57,14 @@ FrameMetrics measureFrame(const cache::FrameRecord& frame) {
   m.time = frame.time;
   m.vertices = frame.positions.size();
   m.triangles = frame.triangles.size();
+  if (!frame.positions.empty()) {
+    Vec3 lo = frame.positions.front(), hi = lo;
+    for (const Vec3& x : frame.positions) {
+      lo = lo.cwiseMin(x);
+      hi = hi.cwiseMax(x);
+    }
+    m.extent = hi - lo;
+  }
   // Each edge with the (up to two) triangles beside it.
   std::map<std::pair<int, int>, std::array<int, 2>> edges;
   for (std::size_t t = 0; t < frame.triangles.size(); ++t)
@@ -256,6 +264,12 @@ std::string inspectJson(const cache::CacheReader& reader) {
     j.key("angle_defect_total").value(m.totalAngleDefect);
     j.key("angle_defect_vertices").value(m.defectVertices);
     j.key("popping").value(m.popping);
+    j.key("extent")
+        .beginArray()
+        .value(m.extent.x())
+        .value(m.extent.y())
+        .value(m.extent.z())
+        .endArray();
     j.endObject();
     previous = std::move(frame);
   }

@@ -47,11 +47,8 @@ it), and the corners stay above the table.
 Run it to regenerate the file (the committed file is its output):
     python3 samples/press-on-sphere/make_press_on_sphere_gltf.py [OUT.gltf]
 """
-import base64
-import json
 import math
 import os
-import struct
 import sys
 
 # ---- geometry and timing (metres, seconds, radians) ----
@@ -76,7 +73,8 @@ V_AXIS = (0.0, 0.0, -1.0)
 
 # Shared helpers (samples/gltf_anim.py).
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from gltf_anim import check_no_stretch, cross, handle_tracks, qaxis, ramp, write_gltf  # noqa: E402
+from gltf_anim import (add_sphere_meshes, check_no_stretch, cross, handle_tracks, qaxis,  # noqa: E402
+                       ramp, write_gltf)
 
 
 # ---- the motion ----
@@ -118,87 +116,13 @@ def check(times, tracks_):
     return check_no_stretch(times, tracks_, pattern, (W, W), (U_AXIS, V_AXIS))
 
 
-# ---- the ball's render mesh ----
-def uv_sphere(radius):
-    """Positions, normals and counter-clockwise (seen from outside) triangle
-    indices of a UV sphere centred on the origin."""
-    nlon, nlat = SPHERE_SEGMENTS
-    positions, normals, indices = [], [], []
-    for i in range(nlat + 1):
-        theta = math.pi * i / nlat               # from the top pole
-        for j in range(nlon + 1):
-            phi = 2.0 * math.pi * j / nlon
-            nrm = (math.sin(theta) * math.cos(phi), math.cos(theta), -math.sin(theta) * math.sin(phi))
-            normals.extend(nrm)
-            positions.extend(radius * c for c in nrm)
-    row = nlon + 1
-    for i in range(nlat):
-        for j in range(nlon):
-            a, b = i * row + j, i * row + j + 1
-            c, d = a + row, b + row
-            if i > 0:
-                indices.extend((a, c, b))
-            if i < nlat - 1:
-                indices.extend((b, c, d))
-    return positions, normals, indices
-
-
-def add_sphere_meshes(path, spheres):
-    """Gives the glTF that write_gltf wrote one UV-sphere mesh per entry of
-    spheres, [(node name, radius, translation or None)], in a second embedded
-    buffer: an existing node (an animated one) gets the mesh, a missing one is
-    added as a static node at the translation (a prop needs a mesh node)."""
-    with open(path) as f:
-        gltf = json.load(f)
-    blob = bytearray()
-    buf = len(gltf["buffers"])
-    gltf["meshes"] = []
-    for name, radius, translation in spheres:
-        positions, normals, indices = uv_sphere(radius)
-        nv = len(positions) // 3
-        first_view = len(gltf["bufferViews"])
-        for values, fmt, target in ((positions, "f", 34962), (normals, "f", 34962),
-                                    (indices, "H", 34963)):
-            while len(blob) % 4:
-                blob.append(0)
-            offset = len(blob)
-            blob.extend(struct.pack("<%d%s" % (len(values), fmt), *values))
-            gltf["bufferViews"].append({"buffer": buf, "byteOffset": offset,
-                                        "byteLength": len(blob) - offset, "target": target})
-        first_acc = len(gltf["accessors"])
-        gltf["accessors"].extend([
-            {"bufferView": first_view, "componentType": 5126, "count": nv, "type": "VEC3",
-             "min": [-radius] * 3, "max": [radius] * 3},
-            {"bufferView": first_view + 1, "componentType": 5126, "count": nv, "type": "VEC3"},
-            {"bufferView": first_view + 2, "componentType": 5123, "count": len(indices),
-             "type": "SCALAR"},
-        ])
-        gltf["meshes"].append({"name": name, "primitives": [{
-            "attributes": {"POSITION": first_acc, "NORMAL": first_acc + 1},
-            "indices": first_acc + 2, "mode": 4}]})
-        mesh = len(gltf["meshes"]) - 1
-        node = next((n for n in gltf["nodes"] if n["name"] == name), None)
-        if node is None:
-            gltf["nodes"].append({"name": name, "translation": list(translation)})
-            gltf["scenes"][0]["nodes"].append(len(gltf["nodes"]) - 1)
-            node = gltf["nodes"][-1]
-        node["mesh"] = mesh
-    gltf["buffers"].append({
-        "byteLength": len(blob),
-        "uri": "data:application/octet-stream;base64," + base64.b64encode(bytes(blob)).decode(),
-    })
-    with open(path, "w") as f:
-        json.dump(gltf, f, indent=1)
-        f.write("\n")
-
-
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "press-on-sphere.gltf")
     times, tr = tracks()
     check(times, tr)
     write_gltf(path, "crumple samples/press-on-sphere/make_press_on_sphere_gltf.py", times, tr)
-    add_sphere_meshes(path, [("Ball", R - BALL_INSET, C)])
+    add_sphere_meshes(path, [("Ball", R - BALL_INSET, C)], SPHERE_SEGMENTS)
 
 
 if __name__ == "__main__":

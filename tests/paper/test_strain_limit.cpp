@@ -255,6 +255,44 @@ TEST(LimitStrain, HandlesBeyondTheSheetsReachLag) {
   EXPECT_TRUE(st.lagVertex == s.handles[0] || st.lagVertex == s.handles[1]);
 }
 
+TEST(LimitStrain, AContactNoStartCanKeepGivesWayToTheBound) {
+  // The step's start is 3 % over its pattern (as a rebuilt S_P can be), and
+  // a contact asks the middle of the top edge 2 cm beyond where the sheet
+  // reaches from its held corner: no start meets the bound and keeps the
+  // contact. The bound wins, the contact is dropped for the step (the
+  // failsafe pushes again at the next one).
+  Shot s;
+  s.handles = {s.g.at(0, 0)};
+  s.before = lift(s.g.pattern);
+  for (Vec3& v : s.before) v.x() *= 1.03;
+  const std::vector<Vec3> targets{Vec3(0.001, 0, 0)};
+  std::vector<Vec3> x = s.before;
+  const int top = s.g.at(s.g.n / 2, s.g.m);
+  const std::vector<KeepOut> keepOut{{top, Vec3(0.05, 0.08, 0.0), Vec3::UnitY()}};
+  const auto limit = [&](std::vector<KeepOut> k) {
+    return limitStrain({s.g.pattern,
+                        s.g.triangles,
+                        s.g.pattern,
+                        s.g.triangles,
+                        s.before,
+                        true,
+                        s.handles,
+                        targets,
+                        {},
+                        0.02,
+                        30,
+                        std::move(k)},
+                       x);
+  };
+  const StrainLimitStats st = limit(keepOut);
+  EXPECT_TRUE(st.ran);
+  EXPECT_TRUE(st.droppedKeepOut);
+  EXPECT_LE(st.maxAfter, 0.02);
+  EXPECT_LE(LengthProjector(s.g.pattern, s.g.triangles).strain(x).first, 0.02);
+  x = s.before;
+  EXPECT_FALSE(limit({}).droppedKeepOut);  // no contact, nothing to drop
+}
+
 TEST(LimitStrain, EachHandleLagsOnlyAsFarAsItMust) {
   // The two bottom corners pulled 10 % beyond their reach; of the top
   // corners one stays and one is lifted 5 mm, which the sheet can follow by

@@ -2,7 +2,8 @@
 // centroid and radius of gyration do not depend on how its surface is
 // triangulated (so a re-meshed S_P that did not move measures 0), the
 // measure is the jump over 3 x (handle motion + 1 mm), and a sheet that
-// jumps while its handles stand still measures far above 1.
+// jumps while its handles stand still measures far above 1; and the
+// bounding box `extent`.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -66,4 +67,12 @@ TEST(Inspect, PoppingIsTheJumpOverTheHandlesMotion) {
     x = 1.1 * (x - Vec3(0.0375, 0.05, 0.0125)) + Vec3(0.0375, 0.05, 0.0125);
   const auto a = pipeline::sheetMoments(before.triangles, before.pattern, before.positions);
   EXPECT_NEAR(pipeline::poppingMeasure(before, spread), 0.1 * a.gyration / 0.003, 1e-9);
+}
+
+// The sheet's bounding box (`extent`, e.g. how small a crumpled ball got):
+// the folded square spans 5 cm in x, 10 cm in y and 5 cm in z.
+TEST(Inspect, ExtentIsTheSheetsBoundingBox) {
+  const cache::FrameRecord folded = foldedSquare(false, Vec3(1.0, 2.0, 3.0));
+  const auto m = pipeline::measureFrame(folded);
+  EXPECT_NEAR((m.extent - Vec3(0.05, 0.1, 0.05)).norm(), 0.0, 1e-12);
 }

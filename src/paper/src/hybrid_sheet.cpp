@@ -301,6 +301,9 @@ std::optional<std::vector<GeometricCutResult>> HybridSheet::tear(
   GeometricMesh g = m.sg;
   const std::vector<Vec3>& x = m.elastic->positions();
   const std::vector<Vec3>& v = m.elastic->velocities();
+  // The elastic step's S_P, for undoing a geometric step that stretches it.
+  const std::vector<Vec3> elasticX = m.params.maxEdgeStrain > 0.0 ? x : std::vector<Vec3>{};
+  const std::vector<Vec3> elasticV = m.params.maxEdgeStrain > 0.0 ? v : std::vector<Vec3>{};
   for (std::size_t i = 0; i < g.vertices.size(); ++i) {
     g.vertices[i].position = x[i];
     g.vertices[i].velocity = v[i];
@@ -395,6 +398,9 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
   const std::vector<Vec2> elasticPattern = m.sp.mesh.pattern;
   const std::vector<Vec3>& x = m.elastic->positions();
   const std::vector<Vec3>& v = m.elastic->velocities();
+  // The elastic step's S_P, for undoing a geometric step that stretches it.
+  const std::vector<Vec3> elasticX = m.params.maxEdgeStrain > 0.0 ? x : std::vector<Vec3>{};
+  const std::vector<Vec3> elasticV = m.params.maxEdgeStrain > 0.0 ? v : std::vector<Vec3>{};
   if (m.traceLevel > 0)
     m.traceElasticStrain = LengthProjector(m.sp.mesh.pattern, m.sp.mesh.triangles).strain(x).first;
   // (c) S_P -> S_G.
@@ -539,6 +545,7 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
     stage = "strain limit";
     t0 = Clock::now();
     const double contactsBefore = stats.ms.contacts + stats.ms.selfContacts;
+    m.undoStretchingGeometry(spBefore, sgBefore, elasticX, elasticV, positions, stats);
     m.limitStepStrain(spBefore, sgBefore, pinned, frame, positions, stats);
     // The contact rounds inside it count as contacts.
     stats.ms.strainLimit =
@@ -546,8 +553,13 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
   }
   if (m.contactsOn()) {
     stage = "contacts";
-    sim::projectOutOfContacts(m.contact, m.sp.mesh.triangles, m.sp.mesh.pattern, m.heldBy(pinned),
-                              positions, &stats.ms.contacts, &stats.ms.selfContacts);
+    // With the strain limit on, the failsafe ran inside it as its
+    // constraints, last before its final projection: where they still
+    // conflict the bound wins (docs/CRUMPLING.md "The geometric step under
+    // the bound").
+    if (m.params.maxEdgeStrain <= 0.0)
+      sim::projectOutOfContacts(m.contact, m.sp.mesh.triangles, m.sp.mesh.pattern, m.heldBy(pinned),
+                                positions, &stats.ms.contacts, &stats.ms.selfContacts);
     const auto carryStart = Clock::now();
     m.carryContacts(elasticContacts, elasticPattern);
     stats.ms.contacts += msSince(carryStart);

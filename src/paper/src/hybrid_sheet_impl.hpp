@@ -126,6 +126,9 @@ struct HybridSheet::Impl {
       traceHinge[static_cast<std::size_t>(stage)] = detail::maxHingeAngle(*elastic);
   }
 
+  bool undoStretchingGeometry(const mesh::SheetMesh& spBefore, const GeometricMesh& sgBefore,
+                              const std::vector<Vec3>& elasticX, const std::vector<Vec3>& elasticV,
+                              std::vector<Vec3>& positions, HybridStepStats& stats);
   void limitStepStrain(const mesh::SheetMesh& spBefore, const GeometricMesh& sgBefore,
                        const std::vector<sim::Pin>& pinned, int frame, std::vector<Vec3>& positions,
                        HybridStepStats& stats);

@@ -11,6 +11,49 @@ namespace crumple::paper {
 
 using detail::allFinite;
 
+// The geometric step (S_G remeshing, cone fits, S_P rebuild and isometry,
+// paper Fig. 16 (c)-(h)) is transactional under the strain bound: when it
+// leaves S_P over maxEdgeStrain and more strained than the elastic step
+// left the step's own S_P, it is undone, and the elastic step's S_P goes on
+// to the limit (docs/CRUMPLING.md "The geometric step under the bound").
+// Returns true when it was undone.
+bool HybridSheet::Impl::undoStretchingGeometry(const mesh::SheetMesh& spBefore,
+                                               const GeometricMesh& sgBefore,
+                                               const std::vector<Vec3>& elasticX,
+                                               const std::vector<Vec3>& elasticV,
+                                               std::vector<Vec3>& positions,
+                                               HybridStepStats& stats) {
+  Impl& m = *this;
+  const double bound = m.params.maxEdgeStrain;
+  if (elasticX.size() != spBefore.positions.size() || sgBefore.vertices.size() > elasticX.size())
+    return false;
+  const double geometric =
+      LengthProjector(m.sp.mesh.pattern, m.sp.mesh.triangles).strain(positions).first;
+  if (geometric <= bound) return false;
+  const double elastic =
+      LengthProjector(spBefore.pattern, spBefore.triangles).strain(elasticX).first;
+  if (elastic >= geometric) return false;
+  GeometricMesh stepped = m.sg;
+  m.sg = sgBefore;
+  for (std::size_t i = 0; i < m.sg.vertices.size(); ++i) {
+    m.sg.vertices[i].position = elasticX[i];
+    m.sg.vertices[i].velocity = elasticV[i];
+  }
+  m.rebuildPhysical();
+  if (m.sp.mesh.triangles != spBefore.triangles || m.sp.mesh.pattern != spBefore.pattern) {
+    // S_P does not come back as it was: the step's structure stays.
+    m.sg = std::move(stepped);
+    m.rebuildPhysical();
+    return false;
+  }
+  positions = elasticX;
+  stats.topologyChanged = false;
+  stats.geometric.notes.push_back("the geometric step undone: it left S_P strained by " +
+                                  std::to_string(geometric) + ", the elastic step by " +
+                                  std::to_string(elastic));
+  return true;
+}
+
 // Paper stays paper after the isometry (strain_limit.hpp): S_P within
 // maxEdgeStrain, the handles on their targets or lagging; a remeshing that
 // leaves no configuration within the bound is undone.
@@ -59,6 +102,7 @@ void HybridSheet::Impl::limitStepStrain(const mesh::SheetMesh& spBefore,
     stats.strainLimit.iterations += first.iterations;
     stats.strainLimit.maxBefore = first.maxBefore;
     stats.strainLimit.ran = stats.strainLimit.ran || first.ran;
+    stats.strainLimit.droppedKeepOut = stats.strainLimit.droppedKeepOut || first.droppedKeepOut;
   };
   contactRound();
   stats.strainLimit = limit();
@@ -94,6 +138,9 @@ void HybridSheet::Impl::limitStepStrain(const mesh::SheetMesh& spBefore,
   for (int round = 0; round < kContactRounds && contactRound(); ++round) {
     if (lengths.strain(positions).first > m.params.maxEdgeStrain) again();
   }
+  // A sheet rebuilt by an undone remeshing (whose S_P differs from the
+  // step's start) has not been through the limit yet when no contact moved.
+  if (lengths.strain(positions).first > m.params.maxEdgeStrain) again();
   if (!allFinite(positions)) throw NumericalError("strain limit", frame, "non-finite positions");
 }
 

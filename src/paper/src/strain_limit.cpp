@@ -413,6 +413,16 @@ StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
   std::vector<Vec3> feasible = base;
   stats = projector.project(feasible, held, aim, in.iterations);
   s.iterations += stats.iterations;
+  if (stats.maxAfter > in.bound && !in.keepOut.empty()) {
+    // The contacts and the bound conflict from the carried start (its
+    // vertices sit elsewhere than the failsafe's half-spaces): the bound
+    // wins, the next contact round or step pushes the sheet out again.
+    projector.setKeepOut({});
+    feasible = base;
+    stats = projector.project(feasible, held, aim, in.iterations);
+    s.iterations += stats.iterations;
+    s.droppedKeepOut = true;
+  }
   if (stats.maxAfter > in.bound) {
     // Not even the carried step's start meets the bound: the best attempt.
     if (stats.maxAfter < bestMax) {

@@ -34,6 +34,7 @@ struct FrameMetrics {
   double totalAngleDefect = 0.0;   // sum of |defect| (discrete total |K| dA, resolution-free)
   std::size_t defectVertices = 0;  // how many were measured
   double popping = 0.0;            // poppingMeasure against the frame before (0 on the first)
+  Vec3 extent = Vec3::Zero();      // side lengths of the sheet's axis-aligned bounding box (m)
 };
 
 // The angle defect of a triangle mesh (Gauss-Bonnet's discrete curvature):
@@ -79,7 +80,8 @@ mesh::SheetMesh sheetOfFrame(const cache::FrameRecord& frame);
 // cache whose header has COLL adds "colliders": [{"name", "material",
 // "friction"}] and, per frame, "contacts" and "max_slide_speed" (m/s).
 // Every frame has "angle_defect_mean", "angle_defect_max",
-// "angle_defect_total" (rad), "angle_defect_vertices" and "popping"
+// "angle_defect_total" (rad), "angle_defect_vertices", "popping" and
+// "extent" ([x, y, z], m: the bounding box of the sheet)
 // (FrameMetrics).
 std::string inspectJson(const cache::CacheReader& reader);
 // The human-readable table (with the colliders and a contacts and a max

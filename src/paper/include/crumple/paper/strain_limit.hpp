@@ -21,7 +21,9 @@
 //     handle that cannot follow does not hold the others back. Failing that, the handles are held
 //     together on the segment from their carried positions (alpha = 0, lengths exact) to their
 //     targets (alpha = 1), at the largest alpha found by bisection that meets the bound. The handle
-//     rig pulls them on at the next step.
+//     rig pulls them on at the next step. When the contacts given
+//     (KeepOut) keep even the carried start over the bound, they are
+//     dropped for this step: the bound wins over a contact.
 #include <array>
 #include <utility>
 #include <vector>
@@ -158,8 +160,11 @@ struct StrainLimitStats {
   int iterations = 0;    // accepted Levenberg-Marquardt steps, every attempt
   bool ran = false;      // maxBefore was above the bound
   bool carried = false;  // the carried start gave the result
-  double lag = 0.0;      // the largest distance of a handle from its target (m)
-  int lagVertex = -1;    // that handle's vertex, or -1
+  // The contacts (KeepOut) could not be kept within the bound from the
+  // carried start and were dropped for the lag (steps 3a-3b).
+  bool droppedKeepOut = false;
+  double lag = 0.0;    // the largest distance of a handle from its target (m)
+  int lagVertex = -1;  // that handle's vertex, or -1
   // Every handle's distance from its target (m), in StrainLimitInput order:
   // (vertex, lag).
   std::vector<std::pair<int, double>> handleLags;
