@@ -301,9 +301,6 @@ std::optional<std::vector<GeometricCutResult>> HybridSheet::tear(
   GeometricMesh g = m.sg;
   const std::vector<Vec3>& x = m.elastic->positions();
   const std::vector<Vec3>& v = m.elastic->velocities();
-  // The elastic step's S_P, for undoing a geometric step that stretches it.
-  const std::vector<Vec3> elasticX = m.params.maxEdgeStrain > 0.0 ? x : std::vector<Vec3>{};
-  const std::vector<Vec3> elasticV = m.params.maxEdgeStrain > 0.0 ? v : std::vector<Vec3>{};
   for (std::size_t i = 0; i < g.vertices.size(); ++i) {
     g.vertices[i].position = x[i];
     g.vertices[i].velocity = v[i];
