@@ -262,6 +262,7 @@ TEST(SoundSamples, FrictionCentroidRisesAsTheSheetShrinks) {
 // the tip's speed) and crackles more (its pitch follows the speed too: more
 // fibres break in each clip, and the largest bursts stand out more).
 TEST(SoundSamples, AFasterTearIsLouderAndCracklesMore) {
+  CRUMPLE_LONG_TEST();  // several minutes
   const TempDir dir;
   const sound::SoundDatabase db = defaultDatabase();
   struct Measure {

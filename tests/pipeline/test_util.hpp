@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -13,6 +14,15 @@
 namespace crumple::testing {
 
 namespace fs = std::filesystem;
+
+// Tests of several minutes each run only with CRUMPLE_LONG_TESTS=1
+// (scripts/test-long.sh), keeping the default suite within its budget.
+#define CRUMPLE_LONG_TEST()                                                                 \
+  do {                                                                                      \
+    const char* long_tests = std::getenv("CRUMPLE_LONG_TESTS");                             \
+    if (long_tests == nullptr || std::string(long_tests) != "1")                            \
+      GTEST_SKIP() << "a long test: runs with CRUMPLE_LONG_TESTS=1 (scripts/test-long.sh)"; \
+  } while (false)
 
 // A fresh folder under the system temp dir, removed at the end of the test.
 class TempDir {
