@@ -208,7 +208,9 @@ TEST(HybridSheet, HandlesThatAskTooMuchLagInsteadOfStretchingThePaper) {
       worst = std::max(
           worst,
           (sp.positions[static_cast<std::size_t>(sheet.handleVertices[k])] - target[k]).norm());
-    EXPECT_NEAR(stats.strainLimit.lag, worst, 1e-12) << "frame " << f;
+    // The frame's largest lag over its animation steps covers its end.
+    EXPECT_GE(stats.strainLimit.lag, worst - 1e-12) << "frame " << f;
+    EXPECT_LE(stats.strainLimit.lag, 1.01 * worst) << "frame " << f;
     lag = std::max(lag, worst);
   }
   // 2 x 10 mm asked, about 2 mm of it within the bound: each lags 8-10 mm.

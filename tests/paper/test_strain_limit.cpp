@@ -341,6 +341,39 @@ TEST(LengthProjector, TowardsTargetsWithinTheBound) {
   EXPECT_LT(reach, 0.0099);
 }
 
+// The lag search's start as the strain limit hands it over when handles
+// lag: their own edges stretched to the soft bound, the rest of the sheet
+// as it was. Here a strip held along its left end, bowed into an arc, with
+// its two right corners asked 2 cm closer to the left end: it can bend
+// further (an isometry) to bring them there. A Gauss-Newton model without
+// the bound's penalty below the soft bound proposes moving the handles
+// alone, every trial breaks through the bound and is rejected, and the
+// search stops where it started (samples/crumple's handles stood 31 mm
+// behind a sheet that no longer moved).
+TEST(LengthProjector, TowardsBendsTheSheetBehindHandlesAtTheBound) {
+  const Grid g = makeGrid(8, 2, 0.1, 0.04);
+  const LengthProjector p(g.pattern, g.triangles);
+  std::vector<Vec3> x = roll(g.pattern, 0.08);
+  std::vector<char> held(x.size(), 0);
+  for (int j = 0; j <= g.m; ++j) held[static_cast<std::size_t>(g.at(0, j))] = 1;
+  const std::vector<int> handles{g.at(g.n, 0), g.at(g.n, g.m)};
+  const double soft = LengthProjector::kSoftBound * 0.02;
+  std::vector<Vec3> targets;
+  for (int h : handles) {
+    // The edge to its left neighbour at the soft bound.
+    Vec3& xh = x[static_cast<std::size_t>(h)];
+    const Vec3& left = x[static_cast<std::size_t>(h - 1)];
+    xh = left + (xh - left).normalized() * (1.0 + soft) * 0.1 / g.n;
+    targets.push_back(xh + Vec3(-0.02, 0.0, 0.0));
+  }
+  ASSERT_NEAR(p.strain(x).first, soft, 1e-9);
+  const double before = (x[static_cast<std::size_t>(handles[0])] - targets[0]).norm();
+  p.projectTowards(x, held, handles, targets, 0.02, 60);
+  EXPECT_LE(p.strain(x).first, 0.02);
+  for (std::size_t h = 0; h < handles.size(); ++h)
+    EXPECT_LT((x[static_cast<std::size_t>(handles[h])] - targets[h]).norm(), 0.1 * before) << h;
+}
+
 TEST(LimitStrain, MergesAFramesHandleLagsByTheirLargest) {
   std::vector<std::pair<int, double>> frame{{3, 0.002}, {7, 0.0}};
   mergeHandleLags({{7, 0.001}, {3, 0.001}, {9, 0.004}}, frame);

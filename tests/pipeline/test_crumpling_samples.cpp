@@ -433,6 +433,20 @@ TEST(CrumplingSamples, ThinnerPaperGetsMoreSingularVertices) {
   ::testing::Test::RecordProperty("singular_eps_0.5", static_cast<int>(medium));
 }
 
+// Paper stays paper on the thinnest paper-types shot, whose structure grows
+// the most: at frame 74 (seed 1) a remeshing gave S_G more vertices than
+// the step's S_P had and left S_P no configuration within the bound; the
+// stage meant to undo it skipped such a step, and every later frame kept
+// one edge at 2.02 %.
+TEST(CrumplingSamples, ThinPaperKeepsTheBoundOnEveryFrame) {
+  TempDir dir;
+  const Shot shot = simulate("paper-types/eps-0.2.toml", 102, std::nullopt, dir);
+  ASSERT_EQ(shot.error, "");
+  ASSERT_EQ(shot.frames.size(), 103u);
+  for (const auto& f : shot.frames)
+    EXPECT_LE(pipeline::measureFrame(f).maxStrain, 0.02) << "frame " << f.frame;
+}
+
 // crumple-ball to the end of the press along X (frame 44): fingers gather
 // an A4 sheet like a closing umbrella while two hands close in. The sheet
 // cannot follow the fingers (they lag by up to 12 cm) and the hands press
@@ -441,6 +455,7 @@ TEST(CrumplingSamples, ThinnerPaperGetsMoreSingularVertices) {
 // stopped acting after the limit, this motion stretched edges by 45-94 %
 // from frame 40 (docs/CRUMPLING.md "The geometric step under the bound").
 TEST(CrumplingSamples, CrumpleBallKeepsTheBoundWhileItsFingersLag) {
+  CRUMPLE_LONG_TEST();  // several minutes
   TempDir dir;
   const Shot shot = simulate("crumple-ball", 44, std::nullopt, dir);
   ASSERT_EQ(shot.error, "");

@@ -107,9 +107,10 @@ void HybridSheet::Impl::limitStepStrain(const mesh::SheetMesh& spBefore,
   contactRound();
   stats.strainLimit = limit();
   if (stats.strainLimit.maxAfter > m.params.maxEdgeStrain && stats.topologyChanged &&
-      spBefore.positions.size() >= m.sg.vertices.size()) {
+      !spBefore.positions.empty()) {
     // The new structure leaves S_P no configuration within the bound from
-    // any start, while the step's start was within it: the step's remeshing
+    // any start, while the step's start was within it (also when S_G now
+    // has more vertices than the step's S_P had): the step's remeshing
     // is undone (transactional, like the cone fits above) and the sheet as
     // it was lags instead; the cooldown keeps the region from being remeshed
     // again at once.
