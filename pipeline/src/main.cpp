@@ -20,6 +20,7 @@
 #include "crumple/pipeline/export.hpp"
 #include "crumple/pipeline/farm.hpp"
 #include "crumple/pipeline/inspect.hpp"
+#include "crumple/pipeline/shape_compare.hpp"
 #include "crumple/pipeline/shot.hpp"
 #include "crumple/pipeline/sound.hpp"
 #include "crumple/render/embree_renderer.hpp"
@@ -51,6 +52,7 @@ struct Args {
   // compare
   std::string imageA, imageB, metric = "flip", diff;
   double tolerance = 0.05;
+  std::optional<double> shapeTolerance;  // caches: m, on every frame's mean distance
   // sound
   std::optional<int> rate, channels;
   std::string format, database;
@@ -191,7 +193,56 @@ ImageRGBA8 readImage(const std::string& path) {
   return exporters::readPng(path);
 }
 
+// `crumple compare A.pcache B.pcache`: the two shots' shapes frame by frame
+// (pipeline/shape_compare.hpp).
+int compareShapesCommand(const Args& a) {
+  const cache::CacheReader ra(a.imageA);
+  const cache::CacheReader rb(a.imageB);
+  std::vector<pipeline::ShapeDistance> d = pipeline::compareShapes(ra, rb);
+  if (!a.frames.empty()) {
+    const pipeline::FrameRange range = pipeline::parseFrameRange(a.frames);
+    std::erase_if(d, [&](const auto& x) { return x.frame < range.first || x.frame > range.last; });
+    if (d.empty()) throw InputError("--frames", "'" + a.frames + "': no frame both caches hold");
+  }
+  double worst = 0.0;
+  int worstFrame = d.front().frame;
+  for (const auto& x : d)
+    if (x.mean > worst) {
+      worst = x.mean;
+      worstFrame = x.frame;
+    }
+  const bool ok = !a.shapeTolerance || worst <= *a.shapeTolerance;
+  if (a.json) {
+    std::printf("{\"frames\": [");
+    for (std::size_t i = 0; i < d.size(); ++i)
+      std::printf(
+          "%s{\"frame\": %d, \"mean\": %.9g, \"max\": %.9g, \"outside\": %zu, "
+          "\"singular_vertices\": %zu}",
+          i > 0 ? ", " : "", d[i].frame, d[i].mean, d[i].max, d[i].outside, d[i].singularVertices);
+    std::printf("], \"worst_mean\": %.9g, \"worst_frame\": %d}\n", worst, worstFrame);
+  } else {
+    std::printf(" frame    mean[m]     max[m]  outside  singular(A)\n");
+    for (const auto& x : d)
+      std::printf("%6d %10.4g %10.4g %8zu %12zu\n", x.frame, x.mean, x.max, x.outside,
+                  x.singularVertices);
+    std::printf("%s largest mean distance %.4g m at frame %d over %zu frames", ok ? "PASS" : "FAIL",
+                worst, worstFrame, d.size());
+    if (a.shapeTolerance) std::printf(" (tolerance %.4g m)", *a.shapeTolerance);
+    std::printf("\n");
+  }
+  return ok ? 0 : 1;
+}
+
+bool isCache(const std::string& path) {
+  return std::filesystem::path(path).extension() == ".pcache";
+}
+
 int compareCommand(const Args& a) {
+  if (isCache(a.imageA) || isCache(a.imageB)) {
+    if (!isCache(a.imageA) || !isCache(a.imageB))
+      throw InputError(a.imageB, "compare takes two images or two .pcache caches");
+    return compareShapesCommand(a);
+  }
   render::ImageMetric metric = render::ImageMetric::Flip;
   if (a.metric == "mae")
     metric = render::ImageMetric::Mae;
@@ -370,10 +421,17 @@ int main(int argc, char** argv) {
                      "print the cache's sound events, one line each, and make no sound");
   auto* compare = app.add_subcommand(
       "compare",
-      "Compare two images (PNG, or EXR as sRGB) for golden-image tests: exit 0 when within "
-      "the tolerance, 1 when not, 2 on bad input; writes a diff image.");
-  compare->add_option("A", a.imageA, "reference image")->required();
-  compare->add_option("B", a.imageB, "image under test")->required();
+      "Compare two images (PNG, or EXR as sRGB) for golden-image tests, writing a diff image; "
+      "or two caches (.pcache) by their shapes: per shared frame, the mean and largest distance "
+      "between the sheets' points at the same pattern position, whatever their meshes "
+      "(docs/CRUMPLING.md). Exit 0 when within the tolerance, 1 when not, 2 on bad input.");
+  compare->add_option("A", a.imageA, "reference image or cache")->required();
+  compare->add_option("B", a.imageB, "image or cache under test")->required();
+  compare->add_option("--shape-tolerance", a.shapeTolerance,
+                      "caches: pass when every frame's mean distance is at most this (m)");
+  compare->add_option("--frames", a.frames,
+                      "caches: A-B, the frames to compare (default: all shared)");
+  compare->add_flag("--json", a.json, "caches: one JSON object for scripts");
   compare
       ->add_option("--metric", a.metric,
                    "mae: mean |difference| over RGBA in 8-bit units; psnr: dB over RGBA; flip: "

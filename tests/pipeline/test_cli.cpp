@@ -73,11 +73,26 @@ TEST(Cli, InspectJsonHasTheDocumentedKeys) {
   const auto r = runCommand(std::string(CRUMPLE_BIN) + " inspect --json " +
                             (tmp / "out/cache.pcache").string() + " 2>/dev/null");
   ASSERT_EQ(r.status, 0);
-  for (const char* key :
-       {"\"format_version\"", "\"fps\"", "\"frame_count\":6", "\"frames\"", "\"frame\"", "\"time\"",
-        "\"vertices\"", "\"triangles\"", "\"c_mean\"", "\"n_comp\"", "\"max_strain\"",
-        "\"max_dihedral\"", "\"handle_error\"", "\"handles\"", "\"name\":\"left\"", "\"position\"",
-        "\"singular_vertices\":0", "\"junction_vertices\":0", "\"tears\":0", "\"popping\""})
+  for (const char* key : {"\"format_version\"",
+                          "\"fps\"",
+                          "\"frame_count\":6",
+                          "\"frames\"",
+                          "\"frame\"",
+                          "\"time\"",
+                          "\"vertices\"",
+                          "\"triangles\"",
+                          "\"c_mean\"",
+                          "\"n_comp\"",
+                          "\"max_strain\"",
+                          "\"max_dihedral\"",
+                          "\"handle_error\"",
+                          "\"handles\"",
+                          "\"name\":\"left\"",
+                          "\"position\"",
+                          "\"singular_vertices\":0",
+                          "\"junction_vertices\":0",
+                          "\"tears\":0",
+                          "\"popping\""})
     EXPECT_NE(r.output.find(key), std::string::npos) << key;
   EXPECT_EQ(r.output.front(), '{');
   const auto text = runCrumple("inspect " + (tmp / "out/cache.pcache").string());
@@ -85,6 +100,45 @@ TEST(Cli, InspectJsonHasTheDocumentedKeys) {
   EXPECT_NE(text.output.find("c_mean"), std::string::npos);
   EXPECT_NE(text.output.find("dihedral"), std::string::npos);
   EXPECT_NE(text.output.find("popping"), std::string::npos);
+}
+
+// `crumple compare A.pcache B.pcache`: the shapes of two shots frame by
+// frame. The same shot measures 0; the same motion on a mesh twice as fine
+// hangs a little differently (more than a micrometre, less than 5 mm) and
+// fails a micrometre's tolerance with exit 1; an image beside a cache, or
+// a frame range the caches do not share, is bad input (2).
+TEST(Cli, CompareTwoCachesByTheirShapes) {
+  TempDir tmp;
+  writeSmallScene(tmp / "scene");
+  fs::create_directories(tmp / "fine");
+  std::string fine = smallSceneToml();
+  fine.replace(fine.find("max_edge = 2.5"), 14, "max_edge = 1.25");
+  writeFile(tmp / "fine/scene.toml", fine);
+  fs::copy_file(tmp / "scene/anim.gltf", tmp / "fine/anim.gltf");
+  for (const char* shot : {"scene", "fine"})
+    ASSERT_EQ(runCrumple("simulate " + (tmp / shot).string() + " --out " +
+                         (tmp / (std::string(shot) + "-out")).string())
+                  .status,
+              0)
+        << shot;
+  const std::string coarse = (tmp / "scene-out/cache.pcache").string();
+  const std::string finer = (tmp / "fine-out/cache.pcache").string();
+  auto r = runCrumple("compare " + coarse + " " + coarse + " --shape-tolerance 1e-12");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("PASS largest mean distance 0 m"), std::string::npos) << r.output;
+  r = runCommand(std::string(CRUMPLE_BIN) + " compare --json " + coarse + " " + finer +
+                 " --frames 2-3 2>/dev/null");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.output.find("{\"frame\": 2, \"mean\": "), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("\"frame\": 4"), std::string::npos) << r.output;
+  const auto worst = r.output.find("\"worst_mean\": ");
+  ASSERT_NE(worst, std::string::npos) << r.output;
+  const double mean = std::stod(r.output.substr(worst + 14));
+  EXPECT_GT(mean, 1e-6);
+  EXPECT_LT(mean, 5e-3);
+  EXPECT_EQ(runCrumple("compare " + coarse + " " + finer + " --shape-tolerance 1e-6").status, 1);
+  EXPECT_EQ(runCrumple("compare " + coarse + " " + (tmp / "missing.png").string()).status, 2);
+  EXPECT_EQ(runCrumple("compare " + coarse + " " + finer + " --frames 50-60").status, 2);
 }
 
 TEST(Cli, RenderAFrameRangeFromTheCacheAlone) {

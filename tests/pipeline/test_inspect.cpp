@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "crumple/pipeline/inspect.hpp"
+#include "crumple/pipeline/shape_compare.hpp"
 
 using namespace crumple;
 
@@ -75,4 +76,74 @@ TEST(Inspect, ExtentIsTheSheetsBoundingBox) {
   const cache::FrameRecord folded = foldedSquare(false, Vec3(1.0, 2.0, 3.0));
   const auto m = pipeline::measureFrame(folded);
   EXPECT_NEAR((m.extent - Vec3(0.05, 0.1, 0.05)).norm(), 0.0, 1e-12);
+}
+
+// `crumple compare A.pcache B.pcache` (pipeline/shape_compare.hpp): the
+// distance between two sheets at the same pattern position does not depend
+// on their triangulations, measures a rigid shift exactly, and sees the
+// chords of a coarse mesh on a curved surface.
+TEST(ShapeCompare, TheSameSurfaceOnTwoMeshesMeasuresZero) {
+  const cache::FrameRecord coarse = foldedSquare(false, Vec3::Zero());
+  const cache::FrameRecord fine = foldedSquare(true, Vec3::Zero());
+  const auto d = pipeline::shapeDistance(coarse.pattern, coarse.triangles, coarse.positions,
+                                         fine.pattern, fine.triangles, fine.positions);
+  EXPECT_NEAR(d.mean, 0.0, 1e-12);
+  EXPECT_NEAR(d.max, 0.0, 1e-12);
+  EXPECT_EQ(d.outside, 0u);
+}
+
+TEST(ShapeCompare, AShiftedSheetMeasuresItsShift) {
+  const cache::FrameRecord a = foldedSquare(false, Vec3::Zero());
+  const cache::FrameRecord b = foldedSquare(true, Vec3(0.0, 0.003, 0.004));
+  const auto d = pipeline::shapeDistance(a.pattern, a.triangles, a.positions, b.pattern,
+                                         b.triangles, b.positions);
+  EXPECT_NEAR(d.mean, 0.005, 1e-12);
+  EXPECT_NEAR(d.max, 0.005, 1e-12);
+}
+
+namespace {
+
+// A w x h grid of n x m squares (each split in two), rolled onto a cylinder
+// of radius r about the y axis (an isometry of the pattern).
+cache::FrameRecord rolledGrid(int n, int m, double w, double h, double r) {
+  cache::FrameRecord f;
+  for (int j = 0; j <= m; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const double x = w * i / n, y = h * j / m;
+      f.pattern.emplace_back(x, y);
+      f.positions.emplace_back(r * std::sin(x / r), y, r - r * std::cos(x / r));
+    }
+  const auto at = [&](int i, int j) { return j * (n + 1) + i; };
+  for (int j = 0; j < m; ++j)
+    for (int i = 0; i < n; ++i) {
+      f.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      f.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  return f;
+}
+
+}  // namespace
+
+TEST(ShapeCompare, ACoarseMeshOnACylinderIsOffByItsChordsSagitta) {
+  const double r = 0.03;
+  const cache::FrameRecord coarse = rolledGrid(4, 2, 0.1, 0.1, r);
+  const cache::FrameRecord fine = rolledGrid(64, 2, 0.1, 0.1, r);
+  const auto d = pipeline::shapeDistance(coarse.pattern, coarse.triangles, coarse.positions,
+                                         fine.pattern, fine.triangles, fine.positions);
+  // The coarse chords span 2.5 cm of arc: their sagitta r (1 - cos(h / 2r)).
+  const double sagitta = r * (1.0 - std::cos(0.025 / (2.0 * r)));
+  EXPECT_GT(d.mean, 0.2 * sagitta);
+  EXPECT_LT(d.mean, sagitta);
+  EXPECT_NEAR(d.max, sagitta, 0.05 * sagitta);
+}
+
+TEST(ShapeCompare, PointsOutsideTheOtherSheetAreCounted) {
+  const cache::FrameRecord big = rolledGrid(4, 4, 0.1, 0.1, 1e3);
+  const cache::FrameRecord small = rolledGrid(4, 4, 0.08, 0.1, 1e3);
+  const auto d = pipeline::shapeDistance(big.pattern, big.triangles, big.positions, small.pattern,
+                                         small.triangles, small.positions);
+  EXPECT_EQ(d.outside, 5u);  // big's column at x = 10 cm lies beyond small's outline
+  EXPECT_THROW(pipeline::shapeDistance(big.pattern, {}, big.positions, small.pattern,
+                                       small.triangles, small.positions),
+               std::invalid_argument);
 }
