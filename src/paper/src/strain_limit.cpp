@@ -65,13 +65,155 @@ LengthProjectionStats LengthProjector::projectTowards(std::vector<Vec3>& x,
   return solve(x, held, handles, targets, 0.0, bound, maxIterations);
 }
 
-// The Levenberg-Marquardt core of project and projectTowards: Gauss-Newton
-// on F(x) = sum_e w_e r_e^2 + (kHandleWeight / l^2) sum_h |x_h - t_h|^2 with
-// w_e = 1 + kBoundWeight [|r_e| > kSoftBound bound] (bound > 0 only), l the
-// mean rest length; the Gauss-Newton model also carries the penalty of the
-// edges a rejected trial pushed past the soft bound (the active set below). With no handles it
-// stops at max |r_e| <= target and returns the least-max iterate; with handles it runs to
-// convergence and returns the last (least-F) iterate.
+namespace {
+
+// The objective of LengthProjector::solve and its Gauss-Newton model:
+// F(x) = sum_e w_e r_e^2 + (kHandleWeight / l^2) sum_h |x_h - t_h|^2 +
+// (kHandleWeight / l^2) sum_k min(0, n_k . (x_k - p_k))^2, with
+// w_e = 1 + kBoundWeight [|r_e| > kSoftBound bound] (bound > 0 only) and
+// l the mean rest length. Free vertex v's coordinates are columns
+// 3 column[v] .. 3 column[v] + 2.
+class LengthObjective {
+ public:
+  LengthObjective(const std::vector<std::array<int, 2>>& edges, const std::vector<double>& rest,
+                  const std::vector<KeepOut>& keepOut, std::size_t vertexCount,
+                  const std::vector<int>& column, const std::vector<int>& handles,
+                  const std::vector<Vec3>& targets, double bound)
+      : edges_(edges),
+        rest_(rest),
+        keepOut_(keepOut),
+        vertexCount_(vertexCount),
+        column_(column),
+        handles_(handles),
+        targets_(targets),
+        bound_(bound),
+        soft_(LengthProjector::kSoftBound * bound),
+        wall_(edges.size(), 0) {
+    double meanRest = 0.0;
+    for (double r : rest) meanRest += r;
+    meanRest /= std::max<std::size_t>(1, rest.size());
+    keepWeight_ = LengthProjector::kHandleWeight / (meanRest * meanRest);
+    handleWeight_ = handles.empty() ? 0.0 : keepWeight_;
+  }
+
+  double cost(const std::vector<Vec3>& p) const {
+    double s = 0.0;
+    for (const KeepOut& k : keepOut_) s += keepWeight_ * inside(k, p) * inside(k, p);
+    for (std::size_t k = 0; k < edges_.size(); ++k) {
+      const double r = residual(p, k);
+      s += r * r + (weight(r) - 1.0) * (std::abs(r) - soft_) * (std::abs(r) - soft_);
+    }
+    for (std::size_t h = 0; h < handles_.size(); ++h)
+      s += handleWeight_ * (p[at(handles_[h])] - targets_[h]).squaredNorm();
+    return s;
+  }
+
+  // The Gauss-Newton matrix J^T W J and gradient J^T W r at x; J's rows
+  // d r_e / d x are -u, +u on the edge's ends with u = d / (l L).
+  void assemble(const std::vector<Vec3>& x, Eigen::SparseMatrix<double>& H, Eigen::VectorXd& g) {
+    const Eigen::Index n = g.size();
+    triplets_.clear();
+    g.setZero();
+    for (std::size_t k = 0; k < edges_.size(); ++k) {
+      const auto [a, b] = edges_[k];
+      const Vec3 d = x[at(b)] - x[at(a)];
+      const double l = d.norm();
+      const double r = (l - rest_[k]) / rest_[k];
+      const double w = weight(r);
+      const double wModel = wall_[k] != 0 ? 1.0 + LengthProjector::kBoundWeight : w;
+      // The penalty's residual is |r| - soft, so its gradient term is
+      // (w - 1)(|r| - soft) sign(r) u beside the plain r u.
+      const double gr = r + (w - 1.0) * (std::abs(r) - soft_) * (r < 0.0 ? -1.0 : 1.0);
+      // A collapsed edge has no direction; its zero block keeps the sparsity
+      // pattern the symbolic analysis was made for.
+      const Vec3 u = l > 0.0 ? Vec3(d / (l * rest_[k])) : Vec3::Zero();
+      const std::array<int, 2> cols{column_[at(a)], column_[at(b)]};
+      const std::array<double, 2> sign{-1.0, 1.0};
+      for (int i = 0; i < 2; ++i) {
+        if (cols[at(i)] < 0) continue;
+        g.segment<3>(3 * cols[at(i)]) += sign[at(i)] * gr * u;
+        for (int j = 0; j < 2; ++j) {
+          if (cols[at(j)] < 0) continue;
+          add(3 * cols[at(i)], 3 * cols[at(j)],
+              wModel * sign[at(i)] * sign[at(j)] * u * u.transpose());
+        }
+      }
+    }
+    // The diagonal always in the pattern, so one symbolic analysis serves.
+    for (Eigen::Index i = 0; i < n; ++i) triplets_.emplace_back(i, i, 0.0);
+    for (std::size_t h = 0; h < handles_.size(); ++h) {
+      const int c = column_[at(handles_[h])];
+      if (c < 0) continue;
+      g.segment<3>(3 * c) += handleWeight_ * (x[at(handles_[h])] - targets_[h]);
+      add(3 * c, 3 * c, handleWeight_ * Mat3::Identity());
+    }
+    for (const KeepOut& k : keepOut_) {
+      const int c = k.vertex >= 0 && at(k.vertex) < vertexCount_ ? column_[at(k.vertex)] : -1;
+      const double s = c < 0 ? 0.0 : inside(k, x);
+      if (s == 0.0) continue;
+      g.segment<3>(3 * c) += keepWeight_ * s * k.normal;
+      add(3 * c, 3 * c, keepWeight_ * k.normal * k.normal.transpose());
+    }
+    H.setFromTriplets(triplets_.begin(), triplets_.end());
+  }
+
+  // The bound's penalty max(0, |r| - soft)^2 has no curvature below the
+  // soft bound, so a model without it proposes steps that push an edge at
+  // the bound through it; the trial is rejected and LM shrinks the step
+  // without ever learning why (on samples/crumple the lag search made no
+  // step at all from frame 34 and the sheet stood still). The edges that
+  // `trial` pushes past the soft bound from below join the model for the
+  // rest of the solve (an active-set Gauss-Newton model, Nocedal & Wright
+  // 2006, Sec. 16.5). True when any did.
+  bool learnBound(const std::vector<Vec3>& x, const std::vector<Vec3>& trial) {
+    if (!(bound_ > 0.0)) return false;
+    bool learned = false;
+    for (std::size_t k = 0; k < edges_.size(); ++k) {
+      if (wall_[k] != 0 || std::abs(residual(x, k)) > soft_) continue;
+      if (std::abs(residual(trial, k)) > soft_) {
+        wall_[k] = 1;
+        learned = true;
+      }
+    }
+    return learned;
+  }
+
+ private:
+  double residual(const std::vector<Vec3>& p, std::size_t k) const {
+    return ((p[at(edges_[k][1])] - p[at(edges_[k][0])]).norm() - rest_[k]) / rest_[k];
+  }
+  // An edge's residual weight: over the soft bound it costs kBoundWeight more.
+  double weight(double r) const {
+    return bound_ > 0.0 && std::abs(r) > soft_ ? 1.0 + LengthProjector::kBoundWeight : 1.0;
+  }
+  static double inside(const KeepOut& k, const std::vector<Vec3>& p) {
+    return std::min(0.0, k.normal.dot(p[at(k.vertex)] - k.point));
+  }
+  void add(Eigen::Index row, Eigen::Index col, const Mat3& block) {
+    for (int p = 0; p < 3; ++p)
+      for (int q = 0; q < 3; ++q) triplets_.emplace_back(row + p, col + q, block(p, q));
+  }
+
+  const std::vector<std::array<int, 2>>& edges_;
+  const std::vector<double>& rest_;
+  const std::vector<KeepOut>& keepOut_;
+  std::size_t vertexCount_;
+  const std::vector<int>& column_;
+  const std::vector<int>& handles_;
+  const std::vector<Vec3>& targets_;
+  double bound_, soft_, keepWeight_ = 0.0, handleWeight_ = 0.0;
+  std::vector<char> wall_;  // edges whose penalty the model carries below the soft bound
+  std::vector<Eigen::Triplet<double>> triplets_;
+};
+
+}  // namespace
+
+// The Levenberg-Marquardt core of project and projectTowards on
+// LengthObjective. With no handles it stops at max |r_e| <= target and
+// returns the least-max iterate; with handles it runs to convergence and
+// returns the last (least-F) iterate, its Gauss-Newton model learning the
+// bound where a rejected trial broke it (LengthObjective::learnBound; the
+// projections with no handles keep their model).
 LengthProjectionStats LengthProjector::solve(std::vector<Vec3>& x, const std::vector<char>& held,
                                              const std::vector<int>& handles,
                                              const std::vector<Vec3>& targets, double target,
@@ -87,123 +229,19 @@ LengthProjectionStats LengthProjector::solve(std::vector<Vec3>& x, const std::ve
   for (int v : used_)
     if (at(v) >= held.size() || held[at(v)] == 0) column[at(v)] = free++;
   if (free == 0) return stats;
-  double meanRest = 0.0;
-  for (double r : rest_) meanRest += r;
-  meanRest /= std::max<std::size_t>(1, rest_.size());
-  const double handleWeight = towards ? kHandleWeight / (meanRest * meanRest) : 0.0;
-  const double soft = kSoftBound * bound;
-  // An edge's residual weight: over the soft bound it costs kBoundWeight more.
-  const auto weight = [&](double r) {
-    return bound > 0.0 && std::abs(r) > soft ? 1.0 + kBoundWeight : 1.0;
-  };
-  const double keepWeight = kHandleWeight / (meanRest * meanRest);
-  const auto inside = [&](const KeepOut& k, const std::vector<Vec3>& p) {
-    return std::min(0.0, k.normal.dot(p[at(k.vertex)] - k.point));
-  };
-  const auto cost = [&](const std::vector<Vec3>& p) {
-    double s = 0.0;
-    for (const KeepOut& k : keepOut_) s += keepWeight * inside(k, p) * inside(k, p);
-    for (std::size_t k = 0; k < edges_.size(); ++k) {
-      const double r = ((p[at(edges_[k][1])] - p[at(edges_[k][0])]).norm() - rest_[k]) / rest_[k];
-      s += r * r + (weight(r) - 1.0) * (std::abs(r) - soft) * (std::abs(r) - soft);
-    }
-    for (std::size_t h = 0; h < handles.size(); ++h)
-      s += handleWeight * (p[at(handles[h])] - targets[h]).squaredNorm();
-    return s;
-  };
+  LengthObjective objective(edges_, rest_, keepOut_, vertexCount_, column, handles, targets, bound);
   const Eigen::Index n = 3 * static_cast<Eigen::Index>(free);
-  // Gauss-Newton matrix J^T W J and gradient J^T W r; J's rows d r_e / d x
-  // are -u, +u on the edge's ends with u = d / (l L).
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(edges_.size() * 36 + static_cast<std::size_t>(n));
   Eigen::SparseMatrix<double> H(n, n);
   Eigen::VectorXd g(n);
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
   bool analysed = false;
-  double f = cost(x), mu = 1e-4;
+  double f = objective.cost(x), mu = 1e-4;
   // The iterate with the smallest max |r_e|: the objective is the sum of
   // squares, the bound is on the max.
   std::vector<Vec3> bestX = x;
   double bestMax = stats.maxBefore;
-  // Edges whose bound penalty the Gauss-Newton model carries although they
-  // are not over the soft bound: the penalty max(0, |r| - soft)^2 has no
-  // curvature below it, so a model without it proposes steps that push an
-  // edge at the bound through it, the trial is rejected, and LM shrinks the
-  // step without ever learning why (on samples/crumple the lag search made
-  // no step at all from frame 34 and the sheet stood still). An edge a
-  // rejected trial pushes past the soft bound joins the model for the rest
-  // of the solve (an active-set Gauss-Newton model, Nocedal & Wright 2006,
-  // Sec. 16.5), and the step is solved again at the same damping.
-  std::vector<char> wall(edges_.size(), 0);
-  const auto assemble = [&] {
-    triplets.clear();
-    g.setZero();
-    for (std::size_t k = 0; k < edges_.size(); ++k) {
-      const auto [a, b] = edges_[k];
-      const Vec3 d = x[at(b)] - x[at(a)];
-      const double l = d.norm();
-      const double r = (l - rest_[k]) / rest_[k];
-      const double w = weight(r);
-      const double wModel = wall[k] != 0 ? 1.0 + kBoundWeight : w;
-      // The penalty's residual is |r| - soft, so its gradient term is
-      // (w - 1)(|r| - soft) sign(r) u beside the plain r u.
-      const double gr = r + (w - 1.0) * (std::abs(r) - soft) * (r < 0.0 ? -1.0 : 1.0);
-      // A collapsed edge has no direction; its zero block keeps the sparsity
-      // pattern the symbolic analysis was made for.
-      const Vec3 u = l > 0.0 ? Vec3(d / (l * rest_[k])) : Vec3::Zero();
-      const std::array<int, 2> cols{column[at(a)], column[at(b)]};
-      const std::array<double, 2> sign{-1.0, 1.0};
-      for (int i = 0; i < 2; ++i) {
-        if (cols[at(i)] < 0) continue;
-        g.segment<3>(3 * cols[at(i)]) += sign[at(i)] * gr * u;
-        for (int j = 0; j < 2; ++j) {
-          if (cols[at(j)] < 0) continue;
-          const Mat3 block = wModel * sign[at(i)] * sign[at(j)] * u * u.transpose();
-          for (int p = 0; p < 3; ++p)
-            for (int q = 0; q < 3; ++q)
-              triplets.emplace_back(3 * cols[at(i)] + p, 3 * cols[at(j)] + q, block(p, q));
-        }
-      }
-    }
-    // The diagonal always in the pattern, so one symbolic analysis serves.
-    for (Eigen::Index i = 0; i < n; ++i) triplets.emplace_back(i, i, 0.0);
-    for (std::size_t h = 0; h < handles.size(); ++h) {
-      const int c = column[at(handles[h])];
-      if (c < 0) continue;
-      g.segment<3>(3 * c) += handleWeight * (x[at(handles[h])] - targets[h]);
-      for (int p = 0; p < 3; ++p) triplets.emplace_back(3 * c + p, 3 * c + p, handleWeight);
-    }
-    for (const KeepOut& k : keepOut_) {
-      const int c = k.vertex >= 0 && at(k.vertex) < vertexCount_ ? column[at(k.vertex)] : -1;
-      const double s = c < 0 ? 0.0 : inside(k, x);
-      if (s == 0.0) continue;
-      g.segment<3>(3 * c) += keepWeight * s * k.normal;
-      const Mat3 block = keepWeight * k.normal * k.normal.transpose();
-      for (int p = 0; p < 3; ++p)
-        for (int q = 0; q < 3; ++q) triplets.emplace_back(3 * c + p, 3 * c + q, block(p, q));
-    }
-    H.setFromTriplets(triplets.begin(), triplets.end());
-  };
-  // Edges not yet in the model that `trial` pushes past the soft bound join
-  // it; true when any did.
-  const auto learnWall = [&](const std::vector<Vec3>& trial) {
-    if (!towards || !(bound > 0.0)) return false;
-    bool learned = false;
-    for (std::size_t k = 0; k < edges_.size(); ++k) {
-      if (wall[k] != 0) continue;
-      const auto [a, b] = edges_[k];
-      const double r0 = ((x[at(b)] - x[at(a)]).norm() - rest_[k]) / rest_[k];
-      if (std::abs(r0) > soft) continue;  // already in the model through w
-      const double r1 = ((trial[at(b)] - trial[at(a)]).norm() - rest_[k]) / rest_[k];
-      if (std::abs(r1) > soft) {
-        wall[k] = 1;
-        learned = true;
-      }
-    }
-    return learned;
-  };
   for (int it = 0; it < maxIterations; ++it) {
-    assemble();
+    objective.assemble(x, H, g);
     Eigen::VectorXd diag = H.diagonal();
     double floor = 1e-9 * std::max(1e-300, diag.maxCoeff());
     bool accepted = false;
@@ -227,7 +265,7 @@ LengthProjectionStats LengthProjector::solve(std::vector<Vec3>& x, const std::ve
       std::vector<Vec3> trial = x;
       for (int v : used_)
         if (const int c = column[at(v)]; c >= 0) trial[at(v)] += step.segment<3>(3 * c);
-      const double ft = cost(trial);
+      const double ft = objective.cost(trial);
       if (ft < f) {
         const double gain = f - ft;
         x = std::move(trial);
@@ -236,8 +274,8 @@ LengthProjectionStats LengthProjector::solve(std::vector<Vec3>& x, const std::ve
         accepted = true;
         ++stats.iterations;
         if (gain < 1e-6 * f) it = maxIterations;  // converged: the last gain is negligible
-      } else if (learnWall(trial)) {
-        assemble();  // the same damping on the model that now sees the bound
+      } else if (towards && objective.learnBound(x, trial)) {
+        objective.assemble(x, H, g);  // the same damping on the model that now sees the bound
         diag = H.diagonal();
         floor = 1e-9 * std::max(1e-300, diag.maxCoeff());
       } else {
@@ -354,7 +392,7 @@ constexpr double kAim = 0.5;
 constexpr int kLocalRings = 2;
 // Levenberg-Marquardt steps of a projectTowards solve (it runs to
 // convergence, not to a bound). The search goes on from where the last
-// animation step's left the sheet, so a few steps per animation step
+// animation step left the sheet, so a few steps per animation step
 // suffice: on samples/crumple 20 leave the largest lag within 5 % of 60's
 // at a quarter of the stage's cost (docs/CRUMPLING.md "The lag search").
 constexpr int kTowardsIterations = 20;
