@@ -2,6 +2,7 @@
 // 0 success, 1 internal failure (including a numerical failure that survived
 // substep halving), 2 bad input.
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -196,6 +197,8 @@ ImageRGBA8 readImage(const std::string& path) {
 // `crumple compare A.pcache B.pcache`: the two shots' shapes frame by frame
 // (pipeline/shape_compare.hpp).
 int compareShapesCommand(const Args& a) {
+  if (a.shapeTolerance && !(std::isfinite(*a.shapeTolerance) && *a.shapeTolerance >= 0.0))
+    throw InputError("--shape-tolerance", "must be a finite distance >= 0 (m)");
   const cache::CacheReader ra(a.imageA);
   const cache::CacheReader rb(a.imageB);
   std::vector<pipeline::ShapeDistance> d = pipeline::compareShapes(ra, rb);

@@ -139,6 +139,8 @@ TEST(Cli, CompareTwoCachesByTheirShapes) {
   EXPECT_EQ(runCrumple("compare " + coarse + " " + finer + " --shape-tolerance 1e-6").status, 1);
   EXPECT_EQ(runCrumple("compare " + coarse + " " + (tmp / "missing.png").string()).status, 2);
   EXPECT_EQ(runCrumple("compare " + coarse + " " + finer + " --frames 50-60").status, 2);
+  EXPECT_EQ(runCrumple("compare " + coarse + " " + finer + " --shape-tolerance nan").status, 2);
+  EXPECT_EQ(runCrumple("compare " + coarse + " " + finer + " --shape-tolerance -1").status, 2);
 }
 
 TEST(Cli, RenderAFrameRangeFromTheCacheAlone) {
