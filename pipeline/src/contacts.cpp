@@ -97,6 +97,8 @@ double contactDepth(const sim::ContactOptions& contact, const cache::FrameRecord
     sim::SelfContactDetector detector(record.triangles, record.pattern, d);
     for (const auto& p : detector.find(record.positions, d, &free))
       depth = std::max(depth, (d - p.distance) / d);
+    for (const auto& c : detector.crossings(record.positions))
+      depth = std::max(depth, 1.0 + c.depth / d);
   }
   return depth;
 }

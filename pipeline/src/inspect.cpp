@@ -11,6 +11,7 @@
 
 #include "crumple/core/error.hpp"
 #include "crumple/exporters/pcache_contacts.hpp"
+#include "crumple/sim/self_contact.hpp"
 #include "json_writer.hpp"
 
 namespace crumple::pipeline {
@@ -133,6 +134,19 @@ FrameMetrics measureFrame(const cache::FrameRecord& frame) {
   return m;
 }
 
+SelfPenetration selfPenetration(const cache::FrameRecord& frame, double thickness) {
+  SelfPenetration out;
+  if (!(thickness > 0.0) || !std::isfinite(thickness) || frame.triangles.empty()) return out;
+  sim::SelfContactDetector detector(frame.triangles, frame.pattern, thickness);
+  for (const sim::SelfContactPair& p : detector.find(frame.positions, thickness))
+    out.depth = std::max(out.depth, (thickness - p.distance) / thickness);
+  const auto crossings = detector.crossings(frame.positions);
+  out.crossings = crossings.size();
+  for (const sim::SelfCrossing& c : crossings)
+    out.depth = std::max(out.depth, 1.0 + c.depth / thickness);
+  return out;
+}
+
 SheetMoments sheetMoments(const std::vector<std::array<int, 3>>& triangles,
                           const std::vector<Vec2>& pattern, const std::vector<Vec3>& positions) {
   // Per triangle: its pattern area A, centroid g and, for a uniform density
@@ -232,6 +246,9 @@ std::string inspectJson(const cache::CacheReader& reader) {
     auto frame = reader.readFrame(i);
     auto m = measure(reader, frame);
     if (previous) m.popping = poppingMeasure(*previous, frame);
+    const SelfPenetration self = selfPenetration(frame, header.paperThickness);
+    m.selfDepth = self.depth;
+    m.selfCrossings = self.crossings;
     j.beginObject();
     j.key("frame").value(m.frame);
     j.key("time").value(m.time);
@@ -264,6 +281,10 @@ std::string inspectJson(const cache::CacheReader& reader) {
     j.key("angle_defect_total").value(m.totalAngleDefect);
     j.key("angle_defect_vertices").value(m.defectVertices);
     j.key("popping").value(m.popping);
+    if (header.paperThickness > 0.0) {
+      j.key("self_depth").value(m.selfDepth);
+      j.key("self_crossings").value(m.selfCrossings);
+    }
     j.key("extent")
         .beginArray()
         .value(m.extent.x())

@@ -3,7 +3,7 @@
 // triangulated (so a re-meshed S_P that did not move measures 0), the
 // measure is the jump over 3 x (handle motion + 1 mm), and a sheet that
 // jumps while its handles stand still measures far above 1; and the
-// bounding box `extent`.
+// bounding box `extent`; and how far the sheet passes into itself.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -82,6 +82,35 @@ TEST(Inspect, ExtentIsTheSheetsBoundingBox) {
 // distance between two sheets at the same pattern position does not depend
 // on their triangulations, measures a rigid shift exactly, and sees the
 // chords of a coarse mesh on a curved surface.
+TEST(Inspect, SelfPenetrationCountsEdgesThroughAnotherLayer) {
+  // The fine square folded flat (180 degrees), its right half 1 mm over
+  // the left: two layers, no contact.
+  cache::FrameRecord f = foldedSquare(true, Vec3::Zero());
+  for (std::size_t v = 0; v < f.pattern.size(); ++v) {
+    const double u = f.pattern[v].x() - 0.05;
+    if (u > 0.0) f.positions[v] = Vec3(0.05 - u, f.pattern[v].y(), 0.001);
+  }
+  constexpr double kThickness = 1e-4;
+  const auto apart = pipeline::selfPenetration(f, kThickness);
+  EXPECT_EQ(apart.crossings, 0u);
+  EXPECT_EQ(apart.depth, 0.0);
+  // The right half's centre pushed 3 mm under the left half: its edges to
+  // the two far corners pass through it, 1 mm (10 thicknesses) past it, and
+  // two edges of the left half through the tilted right half.
+  f.positions[7] = Vec3(0.03, 0.05, -0.003);
+  const auto through = pipeline::selfPenetration(f, kThickness);
+  EXPECT_EQ(through.crossings, 4u);
+  EXPECT_NEAR(through.depth, 11.0, 1e-9);
+  // The right half laid 0.04 mm over the left (0.4 thicknesses): layers in
+  // contact, none through.
+  for (std::size_t v = 0; v < f.pattern.size(); ++v)
+    if (f.pattern[v].x() > 0.05) f.positions[v].z() = 4e-5;
+  f.positions[7] = Vec3(0.025, 0.05, 4e-5);
+  const auto touching = pipeline::selfPenetration(f, kThickness);
+  EXPECT_EQ(touching.crossings, 0u);
+  EXPECT_NEAR(touching.depth, 0.6, 1e-5);
+}
+
 TEST(ShapeCompare, TheSameSurfaceOnTwoMeshesMeasuresZero) {
   const cache::FrameRecord coarse = foldedSquare(false, Vec3::Zero());
   const cache::FrameRecord fine = foldedSquare(true, Vec3::Zero());

@@ -55,6 +55,31 @@ TEST(SelfContact, FindsStackedLayersWithinTheReachAndOnlyThem) {
   EXPECT_EQ(detector.find(near.positions, 2.0 * kThickness, &mask).size(), 3u);
 }
 
+TEST(SelfContact, FindsAnEdgeThatPassesThroughAnotherLayer) {
+  // Triangle 1 stood upright (in the XY plane) with its corner 3 mm below
+  // triangle 0 (the XZ plane), its edges 3-4 and 4-5 through it.
+  Stack pierced(0.0);
+  pierced.positions[3] = {0.004, -0.003, 0.004};
+  pierced.positions[4] = {0.004, 0.01, 0.001};
+  pierced.positions[5] = {0.004, 0.01, 0.007};
+  SelfContactDetector detector(pierced.triangles, pierced.pattern, kThickness);
+  const auto crossings = detector.crossings(pierced.positions);
+  ASSERT_EQ(crossings.size(), 2u);
+  EXPECT_EQ(crossings[0].a, 3);
+  EXPECT_EQ(crossings[0].b, 4);
+  EXPECT_EQ(crossings[1].a, 3);
+  EXPECT_EQ(crossings[1].b, 5);
+  for (const auto& c : crossings) {
+    EXPECT_EQ(c.triangle, 0);
+    EXPECT_NEAR(c.depth, 0.003, 1e-12) << "the shorter part, below the plane";
+  }
+  // Lifted 4 mm, the same triangle stands on the other one: no crossing,
+  // and none when the two layers lie flat on each other.
+  for (auto& x : {3, 4, 5}) pierced.positions[static_cast<std::size_t>(x)].y() += 0.004;
+  EXPECT_TRUE(detector.crossings(pierced.positions).empty());
+  EXPECT_TRUE(detector.crossings(Stack(0.5 * kThickness).positions).empty());
+}
+
 TEST(SelfContact, NeighboursInTheMaterialAreNotContacts) {
   // A flat sheet: every vertex is within reach of triangles around it, but
   // those share a vertex with its triangles or are material neighbours.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
+#include <tuple>
 #include <utility>
 
 #include "crumple/sim/colliders.hpp"
@@ -67,6 +68,46 @@ struct SelfContactDetector::Impl {
     objects[t]->setTranslation(0.5 * (lo + hi));
     objects[t]->computeAABB();
   }
+
+  // Triangle pairs sharing no vertex whose boxes over xs and ys, grown by
+  // reach / 2, overlap: FCL's dynamic AABB tree, built once and refitted per
+  // call; sorted (the tree's traversal order depends on its history).
+  std::vector<std::pair<int, int>> broadPhase(const std::vector<Vec3>& xs,
+                                              const std::vector<Vec3>& ys, double reach) {
+    const std::size_t nt = triangles.size();
+    if (!manager) {
+      manager = std::make_unique<fcl::DynamicAABBTreeCollisionManagerd>();
+      std::vector<fcl::CollisionObjectd*> all;
+      for (std::size_t t = 0; t < nt; ++t) {
+        boxes.push_back(std::make_shared<fcl::Boxd>(1.0, 1.0, 1.0));
+        objects.push_back(std::make_unique<fcl::CollisionObjectd>(boxes.back()));
+        objects.back()->setUserData(reinterpret_cast<void*>(static_cast<std::intptr_t>(t)));
+        fitBox(t, xs, ys, reach);
+        all.push_back(objects.back().get());
+      }
+      manager->registerObjects(all);
+      manager->setup();
+    } else {
+      for (std::size_t t = 0; t < nt; ++t) fitBox(t, xs, ys, reach);
+      manager->update();
+    }
+    BroadPhaseData data;
+    data.triangles = &triangles;
+    manager->collide(&data, recordPair);
+    std::sort(data.pairs.begin(), data.pairs.end());
+    data.pairs.erase(std::unique(data.pairs.begin(), data.pairs.end()), data.pairs.end());
+    lastPairs = data.pairs.size();
+    return std::move(data.pairs);
+  }
+
+  // The pattern distance from point pv (lifted) to pattern triangle t.
+  double patternDistance(const Vec3& pv, std::size_t t) const {
+    const Vec3 pa = lift(pattern[static_cast<std::size_t>(triangles[t][0])]);
+    const Vec3 pb = lift(pattern[static_cast<std::size_t>(triangles[t][1])]);
+    const Vec3 pc = lift(pattern[static_cast<std::size_t>(triangles[t][2])]);
+    const std::array<double, 3> pw = closestBarycentricOnTriangle(pv, pa, pb, pc);
+    return (pv - (pw[0] * pa + pw[1] * pb + pw[2] * pc)).norm();
+  }
 };
 
 SelfContactDetector::SelfContactDetector(std::vector<std::array<int, 3>> triangles,
@@ -102,31 +143,7 @@ std::vector<SelfContactPair> SelfContactDetector::find(const std::vector<Vec3>& 
     throw std::invalid_argument("SelfContactDetector::find: margin must be > 0");
   if (xs.size() != m.pattern.size() || ys.size() != m.pattern.size())
     throw std::invalid_argument("SelfContactDetector::find: positions do not match the sheet");
-  const std::size_t nt = m.triangles.size();
-  // Broad phase: FCL's dynamic AABB tree, built once and refitted per call.
-  if (!m.manager) {
-    m.manager = std::make_unique<fcl::DynamicAABBTreeCollisionManagerd>();
-    std::vector<fcl::CollisionObjectd*> all;
-    for (std::size_t t = 0; t < nt; ++t) {
-      m.boxes.push_back(std::make_shared<fcl::Boxd>(1.0, 1.0, 1.0));
-      m.objects.push_back(std::make_unique<fcl::CollisionObjectd>(m.boxes.back()));
-      m.objects.back()->setUserData(reinterpret_cast<void*>(static_cast<std::intptr_t>(t)));
-      m.fitBox(t, xs, ys, reach);
-      all.push_back(m.objects.back().get());
-    }
-    m.manager->registerObjects(all);
-    m.manager->setup();
-  } else {
-    for (std::size_t t = 0; t < nt; ++t) m.fitBox(t, xs, ys, reach);
-    m.manager->update();
-  }
-  BroadPhaseData data;
-  data.triangles = &m.triangles;
-  m.manager->collide(&data, recordPair);
-  // The tree's traversal order depends on its history: sort for determinism.
-  std::sort(data.pairs.begin(), data.pairs.end());
-  data.pairs.erase(std::unique(data.pairs.begin(), data.pairs.end()), data.pairs.end());
-  m.lastPairs = data.pairs.size();
+  const auto pairs = m.broadPhase(xs, ys, reach);
 
   // Narrow phase: each vertex of one triangle against the other triangle.
   const double exclusion = kSelfContactRestExclusion * m.contactDistance;
@@ -150,12 +167,8 @@ std::vector<SelfContactPair> SelfContactDetector::find(const std::vector<Vec3>& 
     moves += triangleMoves;
     if (!(d < reach + moves)) return;
     // Material neighbours are one layer, not two.
-    const Vec3 pa = lift(m.pattern[static_cast<std::size_t>(t[0])]);
-    const Vec3 pb = lift(m.pattern[static_cast<std::size_t>(t[1])]);
-    const Vec3 pc = lift(m.pattern[static_cast<std::size_t>(t[2])]);
-    const Vec3 pv = lift(m.pattern[vi]);
-    const std::array<double, 3> pw = closestBarycentricOnTriangle(pv, pa, pb, pc);
-    if ((pv - (pw[0] * pa + pw[1] * pb + pw[2] * pc)).norm() < exclusion) return;
+    if (m.patternDistance(lift(m.pattern[vi]), static_cast<std::size_t>(triangle)) < exclusion)
+      return;
     SelfContactPair p;
     p.vertex = vertex;
     p.triangle = triangle;
@@ -176,7 +189,7 @@ std::vector<SelfContactPair> SelfContactDetector::find(const std::vector<Vec3>& 
     if (!p.face && d > 1e-9 * m.contactDistance) p.normal = (xs[vi] - q) / d;
     out.push_back(p);
   };
-  for (const auto& [ta, tb] : data.pairs) {
+  for (const auto& [ta, tb] : pairs) {
     for (int v : m.triangles[static_cast<std::size_t>(ta)]) test(v, tb);
     for (int v : m.triangles[static_cast<std::size_t>(tb)]) test(v, ta);
   }
@@ -200,6 +213,55 @@ std::vector<SelfContactPair> SelfContactDetector::find(const std::vector<Vec3>& 
     i = j;
   }
   return kept;
+}
+
+std::vector<SelfCrossing> SelfContactDetector::crossings(const std::vector<Vec3>& xs) {
+  Impl& m = *impl_;
+  if (xs.size() != m.pattern.size())
+    throw std::invalid_argument("SelfContactDetector::crossings: positions do not match the sheet");
+  const double exclusion = kSelfContactRestExclusion * m.contactDistance;
+  std::vector<SelfCrossing> out;
+  // Segment p-q against triangle t (Moller & Trumbore 1997 in its
+  // plane-side form): strictly opposite sides, the crossing point inside.
+  auto test = [&](int a, int b, int triangle) {
+    const auto& t = m.triangles[static_cast<std::size_t>(triangle)];
+    const Vec3& p = xs[static_cast<std::size_t>(a)];
+    const Vec3& q = xs[static_cast<std::size_t>(b)];
+    const Vec3& ta = xs[static_cast<std::size_t>(t[0])];
+    const Vec3 e1 = xs[static_cast<std::size_t>(t[1])] - ta;
+    const Vec3 e2 = xs[static_cast<std::size_t>(t[2])] - ta;
+    const Vec3 face = e1.cross(e2);
+    const double area2 = face.squaredNorm();
+    if (!(area2 > 0.0)) return;
+    const Vec3 n = face / std::sqrt(area2);
+    const double sp = n.dot(p - ta), sq = n.dot(q - ta);
+    if (!(sp * sq < 0.0)) return;
+    const double s = sp / (sp - sq);
+    const Vec3 r = p + s * (q - p) - ta;
+    const double wb = r.cross(e2).dot(face) / area2;
+    const double wc = e1.cross(r).dot(face) / area2;
+    if (wb < 0.0 || wc < 0.0 || wb + wc > 1.0) return;
+    const Vec2 pv = (1.0 - s) * m.pattern[static_cast<std::size_t>(a)] +
+                    s * m.pattern[static_cast<std::size_t>(b)];
+    if (m.patternDistance(lift(pv), static_cast<std::size_t>(triangle)) < exclusion) return;
+    out.push_back({std::min(a, b), std::max(a, b), triangle, std::min(std::abs(sp), std::abs(sq))});
+  };
+  const double reach = 1e-3 * m.contactDistance;
+  for (const auto& [ta, tb] : m.broadPhase(xs, xs, reach))
+    for (const auto& [from, to] : {std::pair{ta, tb}, std::pair{tb, ta}}) {
+      const auto& t = m.triangles[static_cast<std::size_t>(from)];
+      for (int k = 0; k < 3; ++k)
+        test(t[static_cast<std::size_t>(k)], t[static_cast<std::size_t>((k + 1) % 3)], to);
+    }
+  std::sort(out.begin(), out.end(), [](const SelfCrossing& l, const SelfCrossing& r) {
+    return std::tie(l.a, l.b, l.triangle) < std::tie(r.a, r.b, r.triangle);
+  });
+  out.erase(std::unique(out.begin(), out.end(),
+                        [](const SelfCrossing& l, const SelfCrossing& r) {
+                          return l.a == r.a && l.b == r.b && l.triangle == r.triangle;
+                        }),
+            out.end());
+  return out;
 }
 
 bool sheetIsFolded(const std::vector<std::array<int, 3>>& triangles, const std::vector<Vec3>& xs,

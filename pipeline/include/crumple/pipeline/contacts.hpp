@@ -47,7 +47,9 @@ sim::ContactOptions contactOptionsOf(const io::SceneSpec& scene, SceneColliders&
 // (when self-contact is not off): the contact distance minus its distance
 // over the distance, 0 when none is nearer than the distance. Handle
 // vertices (the record's held ones) are the artist's to place and are left
-// out.
+// out. An edge through another layer (sim::SelfCrossing, which the
+// vertex-triangle pairs cannot see) counts as 1 + how far it reaches past
+// that layer, in thicknesses, as `inspect`'s self_depth does.
 double contactDepth(const sim::ContactOptions& contact, const cache::FrameRecord& record);
 
 }  // namespace crumple::pipeline

@@ -35,7 +35,22 @@ struct FrameMetrics {
   std::size_t defectVertices = 0;  // how many were measured
   double popping = 0.0;            // poppingMeasure against the frame before (0 on the first)
   Vec3 extent = Vec3::Zero();      // side lengths of the sheet's axis-aligned bounding box (m)
+  double selfDepth = 0.0;          // selfPenetration(...).depth (0 without a thickness)
+  std::size_t selfCrossings = 0;   // selfPenetration(...).crossings
 };
+
+// How far the sheet passes into itself, for a paper of thickness h (m, from
+// the cache header): the deepest that one layer reaches into another, in h
+// (a vertex nearer than h to a triangle of another layer: (h - distance) / h;
+// an edge through such a triangle: 1 + how far it reaches past the plane / h,
+// so any crossing counts as more than a whole thickness), and how many edges
+// pass through a triangle. Every vertex counts, held or not; material
+// neighbours are one layer (sim::SelfContactDetector).
+struct SelfPenetration {
+  double depth = 0.0;  // in thicknesses
+  std::size_t crossings = 0;
+};
+SelfPenetration selfPenetration(const cache::FrameRecord& frame, double thickness);
 
 // The angle defect of a triangle mesh (Gauss-Bonnet's discrete curvature):
 // |2 pi - sum of the corner angles| at each vertex that is not on a boundary

@@ -30,6 +30,16 @@ struct SelfContactPair {
   bool face = false;
 };
 
+// An edge of the sheet that passes through a triangle of another layer: two
+// layers crossed, which self-contact exists to prevent (the vertex-triangle
+// pairs above cannot see it once an edge is through).
+struct SelfCrossing {
+  int a = -1;  // the edge's vertices, a < b
+  int b = -1;
+  int triangle = -1;
+  double depth = 0.0;  // how far the edge's shorter part reaches past the triangle's plane (m)
+};
+
 class SelfContactDetector {
  public:
   // The sheet's triangles and pattern (material coordinates, m), and the
@@ -58,6 +68,11 @@ class SelfContactDetector {
   // and mask as find() above.
   std::vector<SelfContactPair> find(const std::vector<Vec3>& start, const std::vector<Vec3>& end,
                                     double margin, const std::vector<char>* vertexMask = nullptr);
+  // Every edge that passes through a triangle sharing no vertex with it
+  // (segment against triangle: the endpoints strictly on both sides of its
+  // plane, the crossing point inside it), material neighbours left out as in
+  // find(); sorted by (a, b, triangle).
+  std::vector<SelfCrossing> crossings(const std::vector<Vec3>& xs);
   // Triangle pairs the last broad phase returned (statistics).
   std::size_t broadPhasePairs() const;
 
