@@ -123,6 +123,7 @@ FrameMetrics measureFrame(const cache::FrameRecord& frame) {
   std::optional<std::vector<cache::ContactRecord>> contacts;
   try {
     contacts = cache::decodeContacts(frame.extensions);
+    m.structure = cache::decodeStructureChanges(frame.extensions);
   } catch (const CorruptDataError& e) {
     throw CorruptDataError("frame " + std::to_string(frame.frame) + ": " + e.what());
   }
@@ -281,6 +282,19 @@ std::string inspectJson(const cache::CacheReader& reader) {
     j.key("angle_defect_total").value(m.totalAngleDefect);
     j.key("angle_defect_vertices").value(m.defectVertices);
     j.key("popping").value(m.popping);
+    if (m.structure) {
+      const cache::StructureChanges& s = *m.structure;
+      j.key("structure_changes").beginObject();
+      j.key("singular_from_flat").value(static_cast<long long>(s.singularFromFlat));
+      j.key("singular_from_ruling").value(static_cast<long long>(s.singularFromRuling));
+      j.key("curved_from_compression").value(static_cast<long long>(s.curvedFromCompression));
+      j.key("curved_from_folding").value(static_cast<long long>(s.curvedFromFolding));
+      j.key("creases").value(static_cast<long long>(s.creases));
+      j.key("flat_splits").value(static_cast<long long>(s.flatSplits));
+      j.key("curved_flattened").value(static_cast<long long>(s.curvedFlattened));
+      j.key("undone_by_stretch").value(static_cast<long long>(s.undoneByStretch));
+      j.endObject();
+    }
     if (header.paperThickness > 0.0) {
       j.key("self_depth").value(m.selfDepth);
       j.key("self_crossings").value(m.selfCrossings);

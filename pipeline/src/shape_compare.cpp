@@ -167,23 +167,20 @@ void checkFrame(const cache::CacheReader& reader, const cache::FrameRecord& f) {
   const auto fail = [&](const std::string& what) {
     throw CorruptDataError(reader.path() + ": frame " + std::to_string(f.frame) + ": " + what);
   };
-  if (f.pattern.size() != f.positions.size())
-    fail("its pattern and positions differ in size");
+  if (f.pattern.size() != f.positions.size()) fail("its pattern and positions differ in size");
   if (f.triangles.empty()) fail("no triangles");
   for (const auto& t : f.triangles)
     for (int v : t)
       if (v < 0 || at(v) >= f.positions.size()) fail("a triangle's vertex is out of range");
   for (std::size_t v = 0; v < f.positions.size(); ++v)
-    if (!f.positions[v].allFinite() || !f.pattern[v].allFinite())
-      fail("a vertex is not finite");
+    if (!f.positions[v].allFinite() || !f.pattern[v].allFinite()) fail("a vertex is not finite");
 }
 
 }  // namespace
 
 ShapeDistance shapeDistance(const std::vector<Vec2>& patternA,
                             const std::vector<std::array<int, 3>>& trianglesA,
-                            const std::vector<Vec3>& positionsA,
-                            const std::vector<Vec2>& patternB,
+                            const std::vector<Vec3>& positionsA, const std::vector<Vec2>& patternB,
                             const std::vector<std::array<int, 3>>& trianglesB,
                             const std::vector<Vec3>& positionsB) {
   if (trianglesA.empty() || trianglesB.empty())
@@ -198,8 +195,7 @@ ShapeDistance shapeDistance(const std::vector<Vec2>& patternA,
   return out;
 }
 
-std::vector<ShapeDistance> compareShapes(const cache::CacheReader& a,
-                                         const cache::CacheReader& b) {
+std::vector<ShapeDistance> compareShapes(const cache::CacheReader& a, const cache::CacheReader& b) {
   std::map<int, std::size_t> inB;
   for (std::size_t i = 0; i < b.frameCount(); ++i) inB[b.frameNumber(i)] = i;
   std::vector<ShapeDistance> out;
@@ -216,8 +212,7 @@ std::vector<ShapeDistance> compareShapes(const cache::CacheReader& a,
     d.singularVertices = fa.singularVertices.size();
     out.push_back(d);
   }
-  if (out.empty())
-    throw InputError(b.path(), "shares no frame number with " + a.path());
+  if (out.empty()) throw InputError(b.path(), "shares no frame number with " + a.path());
   return out;
 }
 

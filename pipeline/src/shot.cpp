@@ -23,6 +23,7 @@
 #include "crumple/core/progress.hpp"
 #include "crumple/exporters/pcache_contacts.hpp"
 #include "crumple/exporters/pcache_sound.hpp"
+#include "crumple/exporters/pcache_structure.hpp"
 #include "crumple/exporters/pcache_tear.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/paper/hybrid_sheet.hpp"
@@ -328,6 +329,22 @@ void writeTextAtomically(const std::string& path, const std::string& text) {
 
 }  // namespace
 
+// The STRC block's counts from a frame's animation steps.
+cache::StructureChanges structureChangesOf(const paper::HybridStepStats& s) {
+  const auto count = [](int n) { return static_cast<std::uint32_t>(std::max(0, n)); };
+  const paper::GeometricStepStats& g = s.geometric;
+  cache::StructureChanges c;
+  c.singularFromFlat = count(g.singularInserted - g.singularInCurved);
+  c.singularFromRuling = count(g.singularInCurved);
+  c.curvedFromCompression = count(g.curvedCreated - g.curvedBent);
+  c.curvedFromFolding = count(g.curvedBent);
+  c.creases = count(g.creases);
+  c.flatSplits = count(g.flatSplits);
+  c.curvedFlattened = count(g.curvedFlattened);
+  c.undoneByStretch = count(s.undoneByBound);
+  return c;
+}
+
 const char* tearKindName(tear::CandidateKind kind) {
   switch (kind) {
     case tear::CandidateKind::Tip:
@@ -589,6 +606,8 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   // The baked tear textures (TEAR block) of the current mesh, re-baked when a
   // tear advances (thesis 3.3.4).
   std::optional<cache::ExtensionBlock> tearAtlasBlock;
+  // The crumpling model's structure changes of the frame being emitted.
+  std::optional<cache::ExtensionBlock> structureBlock;
   mesh::SheetMesh bakedSheet;  // the triangles and pattern tearAtlasBlock refers to
   // Per handle pulled beyond the sheet's reach: first and last frame, most (m).
   std::map<std::size_t, std::tuple<int, int, double>> beyondReach;
@@ -696,6 +715,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     if (auto motions = propMotionBlock(scene, animation.get(), t))
       record.extensions.push_back(std::move(*motions));
     if (tearAtlasBlock) record.extensions.push_back(*tearAtlasBlock);
+    if (structureBlock) record.extensions.push_back(*structureBlock);
     record.tearCount = tearing ? static_cast<std::uint32_t>(tearing->startKinds().size()) : 0;
     std::vector<cache::ContactRecord> touching;
     if (contactsOn) {
@@ -1105,8 +1125,10 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
           report.stages[name].frames += 1;
         }
         carriedContacts.reset();
+        structureBlock = cache::encodeStructureChanges(structureChangesOf(stats));
         if (tearing) tearFrame(frame);
         emit(frame);
+        structureBlock.reset();
         if (options.checkpointEvery > 0 &&
             (frame - scene.frameStart) % options.checkpointEvery == 0)
           checkpoint(frame);

@@ -39,12 +39,15 @@ void accumulate(HybridStepStats& total, const HybridStepStats& s) {
   total.elastic.newtonRetried += s.elastic.newtonRetried;
   total.elastic.selfContactDropped += s.elastic.selfContactDropped;
   total.elasticRetries += s.elasticRetries;
+  total.undoneByBound += s.undoneByBound;
   GeometricStepStats& g = total.geometric;
   const GeometricStepStats& h = s.geometric;
   g.edgeFlips += h.edgeFlips;
   g.flatSplits += h.flatSplits;
   g.curvedCreated += h.curvedCreated;
+  g.curvedBent += h.curvedBent;
   g.singularInserted += h.singularInserted;
+  g.singularInCurved += h.singularInCurved;
   g.creases += h.creases;
   g.junctionMoves += h.junctionMoves;
   g.curvedFlattened += h.curvedFlattened;

@@ -48,6 +48,7 @@ bool HybridSheet::Impl::undoStretchingGeometry(const mesh::SheetMesh& spBefore,
   }
   positions = elasticX;
   stats.topologyChanged = false;
+  ++stats.undoneByBound;
   stats.geometric.notes.push_back("the geometric step undone: it left S_P strained by " +
                                   std::to_string(geometric) + ", the elastic step by " +
                                   std::to_string(elastic));
@@ -116,6 +117,7 @@ void HybridSheet::Impl::limitStepStrain(const mesh::SheetMesh& spBefore,
     // again at once.
     m.sg = sgBefore;
     m.rebuildPhysical();
+    ++stats.undoneByBound;
     keepOut.clear();  // its vertices were the undone S_P's
     if (m.sp.mesh.triangles == spBefore.triangles && m.sp.mesh.pattern == spBefore.pattern) {
       positions = spBefore.positions;

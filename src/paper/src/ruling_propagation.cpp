@@ -996,6 +996,7 @@ void treatCurvedCompression(GeometricMesh& g, const CrumpleParams& params, const
       continue;
     }
     ++stats.singularInserted;
+    ++stats.singularInCurved;
     stats.cuts.push_back(s);
     stats.notes.push_back("curved region " + std::to_string(r) +
                           ": d-cone on a ruling compressed " + std::to_string(cmax));
@@ -1139,6 +1140,7 @@ int bendFoldedFlatRegions(GeometricMesh& g, const CrumpleParams& params,
     if (result.done) {
       ++bent;
       ++stats.curvedCreated;
+      ++stats.curvedBent;
     } else {
       stats.notes.push_back("folded flat region " + std::to_string(r) +
                             " kept its crease: " + result.note);

@@ -4,10 +4,12 @@
 // fold between adjacent triangles, handle error, contacts (the COLL / CONT
 // sub-blocks, exporters/pcache_contacts.hpp).
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "crumple/exporters/pcache.hpp"
+#include "crumple/exporters/pcache_structure.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
 
 namespace crumple::pipeline {
@@ -35,8 +37,11 @@ struct FrameMetrics {
   std::size_t defectVertices = 0;  // how many were measured
   double popping = 0.0;            // poppingMeasure against the frame before (0 on the first)
   Vec3 extent = Vec3::Zero();      // side lengths of the sheet's axis-aligned bounding box (m)
-  double selfDepth = 0.0;          // selfPenetration(...).depth (0 without a thickness)
-  std::size_t selfCrossings = 0;   // selfPenetration(...).crossings
+  // The crumpling model's structure changes in the frame (its STRC block;
+  // nullopt for a frame of the elastic model or an older cache).
+  std::optional<cache::StructureChanges> structure;
+  double selfDepth = 0.0;         // selfPenetration(...).depth (0 without a thickness)
+  std::size_t selfCrossings = 0;  // selfPenetration(...).crossings
 };
 
 // How far the sheet passes into itself, for a paper of thickness h (m, from

@@ -33,15 +33,13 @@ struct ShapeDistance {
 // Throws std::invalid_argument for a sheet without triangles.
 ShapeDistance shapeDistance(const std::vector<Vec2>& patternA,
                             const std::vector<std::array<int, 3>>& trianglesA,
-                            const std::vector<Vec3>& positionsA,
-                            const std::vector<Vec2>& patternB,
+                            const std::vector<Vec3>& positionsA, const std::vector<Vec2>& patternB,
                             const std::vector<std::array<int, 3>>& trianglesB,
                             const std::vector<Vec3>& positionsB);
 
 // Every frame number the two caches share, in order. Throws InputError
 // when they share none, and CorruptDataError naming the file and frame for
 // a frame whose indices or numbers are out of range.
-std::vector<ShapeDistance> compareShapes(const cache::CacheReader& a,
-                                         const cache::CacheReader& b);
+std::vector<ShapeDistance> compareShapes(const cache::CacheReader& a, const cache::CacheReader& b);
 
 }  // namespace crumple::pipeline

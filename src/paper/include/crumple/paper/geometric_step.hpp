@@ -29,7 +29,9 @@ struct GeometricStepStats {
   int edgeFlips = 0;
   int flatSplits = 0;           // flat regions split along an edge above theta_0
   int curvedCreated = 0;        // curved regions created from compressed flat regions
+  int curvedBent = 0;           // of them, flat regions bent along a fold (bendFoldedFlatRegions)
   int singularInserted = 0;     // new singular vertices (paper Sec. 5.2)
+  int singularInCurved = 0;     // of them, on a compressed ruling (treatCurvedCompression)
   int creases = 0;              // degenerate curved regions between two singular vertices
   int junctionMoves = 0;        // junction points moved (paper Sec. 6.1)
   int curvedFlattened = 0;      // curved regions turned back into flat regions

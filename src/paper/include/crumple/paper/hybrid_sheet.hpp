@@ -44,6 +44,10 @@ struct HybridStepStats {
   int coneSegments = 0;
   bool topologyChanged = false;  // S_P was rebuilt with a new connectivity
   int elasticRetries = 0;        // elastic steps retried with the pins snapped onto their targets
+  // Geometric steps and remeshings the strain bound undid (docs/CRUMPLING.md
+  // "The geometric step under the bound"): their structure changes are in
+  // `geometric` all the same.
+  int undoneByBound = 0;
   // The strain limit of the frame's last animation step, except: `ran`,
   // `carried` and `iterations` count the steps, `lag` is the frame's largest.
   StrainLimitStats strainLimit;
