@@ -26,6 +26,7 @@ std::vector<bool> boundaryVertices(const mesh::SheetMesh& sheet) {
 
 std::vector<int> tangentNeighbours(const mesh::SheetMesh& sheet, int vertex, int count) {
   const auto ring = mesh::vertexNeighbours(sheet, vertex);
+  if (ring.empty()) return {};  // a vertex in no triangle has no tangent plane
   const auto onBoundary = boundaryVertices(sheet);
   const Vec2 p = sheet.pattern[static_cast<std::size_t>(vertex)];
   if (count <= 0) {

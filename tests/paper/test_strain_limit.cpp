@@ -121,6 +121,35 @@ TEST(LengthProjector, KeepsTheContactsItIsGiven) {
   EXPECT_LT(deepest(constrained), 2e-5);
 }
 
+// Self-contact as a guard on the projection: a compressed triangle whose
+// free corner, 1 mm over a layer of the sheet, gets its lengths back by
+// moving down through that layer (its two edges pass through it) without
+// the guard; with it the corner stays on its side and the edges do not.
+TEST(LengthProjector, TheCrossingGuardKeepsTheSheetOutOfItself) {
+  const std::vector<Tri> triangles{{0, 1, 2}, {3, 4, 5}};
+  const std::vector<Vec2> pattern{{1.0, 0.0},    {1.1, 0.0},     {1.0, 0.1},
+                                  {0.005, 0.01}, {0.0, 0.00141}, {0.01, 0.00141}};
+  std::vector<Vec3> x{{-0.05, -0.05, 0.0}, {0.05, -0.05, 0.0},   {0.0, 0.05, 0.0},
+                      {0.0, 0.0, 0.001},   {-0.005, 0.0, 0.003}, {0.005, 0.0, 0.003}};
+  std::vector<char> held{1, 1, 1, 0, 1, 1};
+  constexpr double kThickness = 1e-4;
+  LengthProjector free(pattern, triangles);
+  free.setCrossingGuard(kThickness);  // to count them
+  ASSERT_EQ(free.crossings(x), 0u);
+  free.setCrossingGuard(0.0);
+  std::vector<Vec3> unguarded = x;
+  free.project(unguarded, held, 1e-6, 50);
+  free.setCrossingGuard(kThickness);
+  EXPECT_EQ(free.crossings(unguarded), 2u) << "without the guard it passes through";
+  EXPECT_LT(unguarded[3].z(), -0.005);
+  LengthProjector guarded(pattern, triangles);
+  guarded.setCrossingGuard(kThickness);
+  std::vector<Vec3> kept = x;
+  guarded.project(kept, held, 1e-6, 50);
+  EXPECT_EQ(guarded.crossings(kept), 0u);
+  EXPECT_GT(kept[3].z(), 0.0) << "the corner stays over the layer";
+}
+
 TEST(LengthProjector, NeverRaisesTheMaxStrain) {
   // Two held corners further apart than the sheet reaches: no isometry; the
   // projection lowers the residual and returns its iterate of least max.

@@ -105,7 +105,11 @@ TEST(CrumplingSamples, FirstSingularityHasTheShapeOfAFineMesh) {
 // paper Fig. 1: the wrap into a cylinder is smooth -- no singular vertex,
 // rulings parallel to the cylinder's axis (the pattern's v direction) within
 // 5 degrees; the orthogonal bend then makes singular vertices; lengths are
-// kept (paper Table IV measures) on every frame of the shot.
+// kept (paper Table IV measures) on every frame of the shot, and the sheet
+// never passes through itself (without the crossing guard 122 edges did
+// from frame 73, where a 0.25 cm elastic reference does not even touch
+// itself). Where the guard stops it, up to 3.4 % of the edges are
+// compressed by more than 1 % (0.6 % without it).
 TEST(CrumplingSamples, CylinderFoldWrapIsSmoothThenTheBendMakesSingularVertices) {
   TempDir dir;
   const Shot shot = simulate("cylinder-fold", 102, std::nullopt, dir);
@@ -130,7 +134,8 @@ TEST(CrumplingSamples, CylinderFoldWrapIsSmoothThenTheBendMakesSingularVertices)
     }
     previousSingular = f.singularVertices.size();
     EXPECT_LE(m.cMean, 0.005) << "frame " << f.frame;
-    EXPECT_LE(m.nComp, 0.02) << "frame " << f.frame;
+    EXPECT_LE(m.nComp, 0.04) << "frame " << f.frame;
+    EXPECT_EQ(pipeline::selfPenetration(f, 9e-5).crossings, 0u) << "frame " << f.frame;
     worstCMean = std::max(worstCMean, m.cMean);
     worstNComp = std::max(worstNComp, m.nComp);
     if (f.frame > 53) continue;  // the bend starts at 2.25 s (frame 54)
@@ -445,18 +450,22 @@ TEST(CrumplingSamples, MoebiusStaysIsometric) {
 }
 
 // paper Fig. 22 second row: the crumple sample runs to its end with finite
-// positions, a valid pattern triangulation (no inverted triangle) and S_P
-// under 400 triangles. The issue asks for at least 20 singular vertices;
-// the model reaches 11-16 over seeds 1-6 (docs/CRUMPLING.md): recorded.
+// positions, a valid pattern triangulation (no inverted triangle), S_P
+// under 400 triangles and no edge through another layer. The issue asks for at least 20 singular
+// vertices; the model reaches 11-16 over seeds 1-6 (docs/CRUMPLING.md): recorded.
 TEST(CrumplingSamples, CrumpleRunsToTheEndWithACoarseValidMesh) {
   TempDir dir;
   const Shot shot = simulate("crumple", 108, std::nullopt, dir);
   ASSERT_EQ(shot.error, "");
   ASSERT_EQ(shot.frames.size(), 109u);
   std::size_t maxTriangles = 0;
+  constexpr double kThickness = 9e-5;  // office-70gsm (assets/papers)
   for (const auto& f : shot.frames) {
     maxTriangles = std::max(maxTriangles, f.triangles.size());
     for (const Vec3& x : f.positions) ASSERT_TRUE(x.allFinite()) << "frame " << f.frame;
+    // Self-contact (on from the fold): no layer passes through another (91
+    // edges did at the end before the crossing guard).
+    EXPECT_EQ(pipeline::selfPenetration(f, kThickness).crossings, 0u) << "frame " << f.frame;
     for (const auto& t : f.triangles) {
       const Vec2 a =
           f.pattern[static_cast<std::size_t>(t[1])] - f.pattern[static_cast<std::size_t>(t[0])];

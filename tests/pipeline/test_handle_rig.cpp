@@ -138,3 +138,15 @@ TEST(HandleRig, RebindTurnsThePatternOntoTheCurrentTangentPlane) {
     EXPECT_LT((pin.position - (node + turn * f.flat(pin.vertex))).norm(), 1e-12)
         << "vertex " << pin.vertex;
 }
+
+// A handle vertex that a tear or a remeshing left in no triangle has no
+// tangent plane: no tangent vertices (it indexed an empty one-ring before).
+TEST(HandleRig, AVertexInNoTriangleHasNoTangentNeighbours) {
+  mesh::SheetMesh sheet;
+  sheet.pattern = {{0.0, 0.0}, {0.01, 0.0}, {0.0, 0.01}, {0.05, 0.05}};
+  sheet.positions = {{0.0, 0.0, 0.0}, {0.01, 0.0, 0.0}, {0.0, 0.01, 0.0}, {0.05, 0.05, 0.0}};
+  sheet.triangles = {{0, 1, 2}};
+  sheet.regionOfTriangle = {0};
+  EXPECT_TRUE(pipeline::tangentNeighbours(sheet, 3, 0).empty());
+  EXPECT_EQ(pipeline::tangentNeighbours(sheet, 0, 0).size(), 2u) << "a corner: 2";
+}

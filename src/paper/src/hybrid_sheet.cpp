@@ -378,6 +378,8 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
   // (a)-(b) elastic relaxation of S_P with the handles as hard constraints.
   stage = "elastic";
   auto t0 = Clock::now();
+  const std::vector<Vec3> elasticStart =
+      m.crossingGuard() > 0.0 ? m.elastic->positions() : std::vector<Vec3>{};
   try {
     stats.elastic = m.elastic->advance(t, dt, pins);
   } catch (const NumericalError&) {
@@ -392,6 +394,7 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
     stats.elastic = m.elastic->advance(t, dt, pins);
     ++stats.elasticRetries;
   }
+  m.keepElasticStepOutOfItself(elasticStart, dt);
   stats.ms.elastic = msSince(t0);
   m.noteHinge(0);
   const std::vector<sim::ContactSample> elasticContacts = m.elastic->contacts();
@@ -533,6 +536,14 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
   std::vector<Vec3> positions = m.sp.mesh.positions;
   stats.isometry = m.isometry->project(positions, m.params.isometryIterations);
   if (!allFinite(positions)) throw NumericalError("isometry", frame, "non-finite positions");
+  if (m.passesThroughItself(m.sp.mesh.positions, positions)) {
+    // Nor let it move the sheet through itself: it knows no contacts (cut
+    // back to where it would, rather than dropped, it leaves S_P compressed:
+    // docs/CRUMPLING.md "Self-contact in the crumpling samples").
+    positions = m.sp.mesh.positions;
+    stats.isometry.meanLengthErrorAfter = stats.isometry.meanLengthErrorBefore;
+    stats.isometry.meanDisplacement = 0.0;
+  }
   if (stats.isometry.meanLengthErrorAfter > stats.isometry.meanLengthErrorBefore) {
     // Never let the projection make lengths worse (it has no convergence
     // guarantee, paper Sec. 6.3): keep the unprojected S_P then.

@@ -20,6 +20,7 @@
 #include "crumple/paper/damage.hpp"
 #include "crumple/paper/hybrid_sheet.hpp"
 #include "crumple/sim/colliders.hpp"
+#include "crumple/sim/self_contact.hpp"
 #include "region_tools.hpp"
 #include "step_trace.hpp"
 
@@ -66,6 +67,16 @@ struct HybridSheet::Impl {
   bool contactsOn() const {
     return (contact.colliders != nullptr && contact.colliders->size() > 0) ||
            contact.self != sim::SelfContactMode::Off;
+  }
+  // The paper's thickness while self-contact runs for S_P as it is (On, or
+  // Auto and folded: sim::sheetIsFolded), else 0: no stage may then move
+  // S_P through itself (keepElasticStepOutOfItself, the isometry's guard,
+  // LengthProjector::setCrossingGuard).
+  double crossingGuard() const {
+    const bool on = contact.self == sim::SelfContactMode::On ||
+                    (contact.self == sim::SelfContactMode::Auto &&
+                     sim::sheetIsFolded(sp.mesh.triangles, sp.mesh.positions, contact.foldSpread));
+    return on ? contact.distance : 0.0;
   }
   // Where compression was treated in the last remeshCooldown steps, and how
   // many more steps each point blocks remeshing of the region holding it.
@@ -129,6 +140,17 @@ struct HybridSheet::Impl {
   bool undoStretchingGeometry(const mesh::SheetMesh& spBefore, const GeometricMesh& sgBefore,
                               const std::vector<Vec3>& elasticX, const std::vector<Vec3>& elasticV,
                               std::vector<Vec3>& positions, HybridStepStats& stats);
+  // The largest fraction of the move from x0 to x1 (S_P's vertices) that
+  // passes no more edges through another layer than x0 had; x1 becomes that
+  // point of the move (crossingGuard() > 0). Returns the fraction.
+  double keepMoveOutOfItself(const std::vector<Vec3>& x0, std::vector<Vec3>& x1) const;
+  // Whether x1 passes more edges through another layer than x0 does (S_P's
+  // vertices; false when crossingGuard() is 0).
+  bool passesThroughItself(const std::vector<Vec3>& x0, const std::vector<Vec3>& x1) const;
+  // The elastic step from x0 over dt, shortened to the largest fraction that
+  // passes no more of S_P's edges through another layer than x0 had
+  // (crossingGuard() > 0). Returns the fraction (1: the whole step).
+  double keepElasticStepOutOfItself(const std::vector<Vec3>& x0, double dt);
   void limitStepStrain(const mesh::SheetMesh& spBefore, const GeometricMesh& sgBefore,
                        const std::vector<sim::Pin>& pinned, int frame, std::vector<Vec3>& positions,
                        HybridStepStats& stats);

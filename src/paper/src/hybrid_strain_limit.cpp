@@ -55,6 +55,62 @@ bool HybridSheet::Impl::undoStretchingGeometry(const mesh::SheetMesh& spBefore,
   return true;
 }
 
+// Counts S_P's edges through another layer at both (SelfContactDetector::
+// crossings).
+bool HybridSheet::Impl::passesThroughItself(const std::vector<Vec3>& x0,
+                                            const std::vector<Vec3>& x1) const {
+  const double h = crossingGuard();
+  if (!(h > 0.0) || x0.size() != x1.size()) return false;
+  LengthProjector guard(sp.mesh.pattern, sp.mesh.triangles);
+  guard.setCrossingGuard(h);
+  return guard.crossings(x1) > guard.crossings(x0);
+}
+
+// The largest fraction of the move from x0 to x1 (S_P's current mesh) that
+// passes no more edges through another layer than x0 had, by bisection to
+// 1/64 of the move: a discrete stand-in for continuous collision detection
+// (Bridson et al. 2002, Sec. 7) that stops the sheet where it would pass
+// through itself. x1 becomes that point of the move; returns the fraction.
+double HybridSheet::Impl::keepMoveOutOfItself(const std::vector<Vec3>& x0,
+                                              std::vector<Vec3>& x1) const {
+  const double h = crossingGuard();
+  if (!(h > 0.0) || x0.size() != x1.size()) return 1.0;
+  LengthProjector guard(sp.mesh.pattern, sp.mesh.triangles);
+  guard.setCrossingGuard(h);
+  const std::size_t allowed = guard.crossings(x0);
+  if (guard.crossings(x1) <= allowed) return 1.0;
+  const auto at = [&](double alpha) {
+    std::vector<Vec3> x(x0.size());
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] = x0[i] + alpha * (x1[i] - x0[i]);
+    return x;
+  };
+  constexpr int kBisections = 6;  // to 1/64 of the move
+  double lo = 0.0, hi = 1.0;
+  for (int k = 0; k < kBisections; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (guard.crossings(at(mid)) <= allowed ? lo : hi) = mid;
+  }
+  x1 = at(lo);
+  return lo;
+}
+
+// The elastic step's self-contact is vertex against triangle, and S_P's
+// edges (centimetres long on a sheet a tenth of a millimetre thick) pass
+// through each other with no vertex near another layer: the step is cut
+// back where it would pass S_P through itself (keepMoveOutOfItself), its
+// velocities to the move it made (docs/CRUMPLING.md "Self-contact in the
+// crumpling samples").
+double HybridSheet::Impl::keepElasticStepOutOfItself(const std::vector<Vec3>& x0, double dt) {
+  std::vector<Vec3> x = elastic->positions();
+  const double alpha = keepMoveOutOfItself(x0, x);
+  if (alpha >= 1.0) return alpha;
+  std::vector<Vec3> v(x.size());
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = (x[i] - x0[i]) / dt;
+  elastic->setPositions(x);
+  elastic->setVelocities(v);
+  return alpha;
+}
+
 // Paper stays paper after the isometry (strain_limit.hpp): S_P within
 // maxEdgeStrain, the handles on their targets or lagging; a remeshing that
 // leaves no configuration within the bound is undone.
@@ -83,7 +139,7 @@ void HybridSheet::Impl::limitStepStrain(const mesh::SheetMesh& spBefore,
     return limitStrain(
         {m.sp.mesh.pattern, m.sp.mesh.triangles, spBefore.pattern, spBefore.triangles,
          spBefore.positions, sameMesh, handles, targets, tangentPins, m.params.maxEdgeStrain,
-         m.params.strainLimitIterations, keepOut},
+         m.params.strainLimitIterations, keepOut, m.crossingGuard()},
         positions);
   };
   // Contacts as constraints of the limit: the failsafe's moves are kept

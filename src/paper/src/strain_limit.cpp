@@ -23,7 +23,7 @@ std::size_t at(int i) { return static_cast<std::size_t>(i); }
 
 LengthProjector::LengthProjector(const std::vector<Vec2>& pattern,
                                  const std::vector<std::array<int, 3>>& triangles)
-    : vertexCount_(pattern.size()) {
+    : vertexCount_(pattern.size()), triangles_(triangles), pattern_(pattern) {
   std::map<std::pair<int, int>, int> seen;
   std::vector<char> used(pattern.size(), 0);
   for (const auto& t : triangles)
@@ -39,6 +39,16 @@ LengthProjector::LengthProjector(const std::vector<Vec2>& pattern,
     }
   for (std::size_t v = 0; v < used.size(); ++v)
     if (used[v] != 0) used_.push_back(static_cast<int>(v));
+}
+
+void LengthProjector::setCrossingGuard(double thickness) {
+  crossingGuard_.reset();
+  if (thickness > 0.0 && std::isfinite(thickness) && !triangles_.empty())
+    crossingGuard_ = std::make_shared<sim::SelfContactDetector>(triangles_, pattern_, thickness);
+}
+
+std::size_t LengthProjector::crossings(const std::vector<Vec3>& x) const {
+  return crossingGuard_ ? crossingGuard_->crossings(x).size() : 0;
 }
 
 std::pair<double, double> LengthProjector::strain(const std::vector<Vec3>& x) const {
@@ -236,6 +246,7 @@ LengthProjectionStats LengthProjector::solve(std::vector<Vec3>& x, const std::ve
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
   bool analysed = false;
   double f = objective.cost(x), mu = 1e-4;
+  std::size_t crossed = crossings(x);
   // The iterate with the smallest max |r_e|: the objective is the sum of
   // squares, the bound is on the max.
   std::vector<Vec3> bestX = x;
@@ -266,7 +277,9 @@ LengthProjectionStats LengthProjector::solve(std::vector<Vec3>& x, const std::ve
       for (int v : used_)
         if (const int c = column[at(v)]; c >= 0) trial[at(v)] += step.segment<3>(3 * c);
       const double ft = objective.cost(trial);
-      if (ft < f) {
+      const std::size_t trialCrossed = ft < f ? crossings(trial) : crossed;
+      if (ft < f && trialCrossed <= crossed) {
+        crossed = trialCrossed;
         const double gain = f - ft;
         x = std::move(trial);
         f = ft;
@@ -420,6 +433,7 @@ StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
   StrainLimitStats s;
   LengthProjector projector(in.pattern, in.triangles);
   projector.setKeepOut(in.keepOut);
+  projector.setCrossingGuard(in.crossingGuard);
   std::tie(s.maxBefore, s.meanAfter) = projector.strain(x);
   s.maxAfter = s.maxBefore;
   const auto finish = [&](std::vector<Vec3> chosen) {

@@ -25,11 +25,13 @@
 //     (KeepOut) keep even the carried start over the bound, they are
 //     dropped for this step: the bound wins over a contact.
 #include <array>
+#include <memory>
 #include <utility>
 #include <vector>
 
 #include "crumple/core/types.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
+#include "crumple/sim/self_contact.hpp"
 
 namespace crumple::paper {
 
@@ -96,6 +98,15 @@ class LengthProjector {
   // strain limit then works with the contact failsafe, not against it.
   void setKeepOut(std::vector<KeepOut> keepOut) { keepOut_ = std::move(keepOut); }
 
+  // Self-contact as a guard on every projection (`thickness` > 0, the
+  // paper's, m; 0 turns it off): a Levenberg-Marquardt step is accepted only
+  // when it passes no more edges through another layer than the iterate had
+  // (sim::SelfContactDetector::crossings), so a projection never moves the
+  // sheet through itself.
+  void setCrossingGuard(double thickness);
+  // Edges through another layer at x (0 without the guard).
+  [[nodiscard]] std::size_t crossings(const std::vector<Vec3>& x) const;
+
  private:
   LengthProjectionStats solve(std::vector<Vec3>& x, const std::vector<char>& held,
                               const std::vector<int>& handles, const std::vector<Vec3>& targets,
@@ -105,6 +116,9 @@ class LengthProjector {
   std::vector<int> used_;  // vertices in some triangle
   std::vector<KeepOut> keepOut_;
   std::size_t vertexCount_ = 0;
+  std::vector<std::array<int, 3>> triangles_;
+  std::vector<Vec2> pattern_;
+  std::shared_ptr<sim::SelfContactDetector> crossingGuard_;  // refitted per call
 };
 
 // The rigid motion (R, t) minimising sum_i |R a_i + t - b_i|^2 (Kabsch 1976).
@@ -151,6 +165,9 @@ struct StrainLimitInput {
   // Contacts the projections keep (LengthProjector::setKeepOut); the
   // positions given are already out of them.
   std::vector<KeepOut> keepOut = {};
+  // The paper's thickness when self-contact is on (LengthProjector::
+  // setCrossingGuard), else 0.
+  double crossingGuard = 0.0;
 };
 
 struct StrainLimitStats {
