@@ -450,7 +450,10 @@ int main(int argc, char** argv) {
       "Print per-frame sizes, strain, sharpest fold, handle error and popping (the sheet's jump "
       "against its handles' motion, docs/CRUMPLING.md) of a cache.");
   inspect->add_option("CACHE", a.cache, "a .pcache file")->required();
-  inspect->add_flag("--json", a.json, "one JSON object for scripts");
+  inspect->add_flag("--json", a.json,
+                    "one JSON object for scripts; per frame also how far the sheet passes into "
+                    "itself (self_depth in thicknesses, self_crossings) and the crumpling "
+                    "model's structure changes (structure_changes)");
   auto* exportCmd = app.add_subcommand(
       "export",
       "Export cached frames for DCC tools (docs/EXPORT.md): obj (NNNN.obj + .mtl, UVs = the "
