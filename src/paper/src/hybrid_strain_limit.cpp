@@ -61,9 +61,8 @@ bool HybridSheet::Impl::passesThroughItself(const std::vector<Vec3>& x0,
                                             const std::vector<Vec3>& x1) const {
   const double h = crossingGuard();
   if (!(h > 0.0) || x0.size() != x1.size()) return false;
-  LengthProjector guard(sp.mesh.pattern, sp.mesh.triangles);
-  guard.setCrossingGuard(h);
-  return guard.crossings(x1) > guard.crossings(x0);
+  sim::SelfContactDetector detector(sp.mesh.triangles, sp.mesh.pattern, h);
+  return detector.crossings(x1).size() > detector.crossings(x0).size();
 }
 
 // The largest fraction of the move from x0 to x1 (S_P's current mesh) that
@@ -75,10 +74,10 @@ double HybridSheet::Impl::keepMoveOutOfItself(const std::vector<Vec3>& x0,
                                               std::vector<Vec3>& x1) const {
   const double h = crossingGuard();
   if (!(h > 0.0) || x0.size() != x1.size()) return 1.0;
-  LengthProjector guard(sp.mesh.pattern, sp.mesh.triangles);
-  guard.setCrossingGuard(h);
-  const std::size_t allowed = guard.crossings(x0);
-  if (guard.crossings(x1) <= allowed) return 1.0;
+  sim::SelfContactDetector detector(sp.mesh.triangles, sp.mesh.pattern, h);
+  const auto crossings = [&](const std::vector<Vec3>& x) { return detector.crossings(x).size(); };
+  const std::size_t allowed = crossings(x0);
+  if (crossings(x1) <= allowed) return 1.0;
   const auto at = [&](double alpha) {
     std::vector<Vec3> x(x0.size());
     for (std::size_t i = 0; i < x.size(); ++i) x[i] = x0[i] + alpha * (x1[i] - x0[i]);
@@ -88,7 +87,7 @@ double HybridSheet::Impl::keepMoveOutOfItself(const std::vector<Vec3>& x0,
   double lo = 0.0, hi = 1.0;
   for (int k = 0; k < kBisections; ++k) {
     const double mid = 0.5 * (lo + hi);
-    (guard.crossings(at(mid)) <= allowed ? lo : hi) = mid;
+    (crossings(at(mid)) <= allowed ? lo : hi) = mid;
   }
   x1 = at(lo);
   return lo;
