@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "crumple/sim/self_contact.hpp"
+#include "crumple/pipeline/inspect.hpp"
 
 namespace crumple::pipeline {
 
@@ -93,13 +93,8 @@ double contactDepth(const sim::ContactOptions& contact, const cache::FrameRecord
         depth = std::max(depth, (d - c->distance) / d);
     }
   }
-  if (contact.self != sim::SelfContactMode::Off) {
-    sim::SelfContactDetector detector(record.triangles, record.pattern, d);
-    for (const auto& p : detector.find(record.positions, d, &free))
-      depth = std::max(depth, (d - p.distance) / d);
-    for (const auto& c : detector.crossings(record.positions))
-      depth = std::max(depth, 1.0 + c.depth / d);
-  }
+  if (contact.self != sim::SelfContactMode::Off)
+    depth = std::max(depth, selfPenetration(record, d, &free).depth);
   return depth;
 }
 

@@ -135,11 +135,12 @@ FrameMetrics measureFrame(const cache::FrameRecord& frame) {
   return m;
 }
 
-SelfPenetration selfPenetration(const cache::FrameRecord& frame, double thickness) {
+SelfPenetration selfPenetration(const cache::FrameRecord& frame, double thickness,
+                                const std::vector<char>* vertexMask) {
   SelfPenetration out;
   if (!(thickness > 0.0) || !std::isfinite(thickness) || frame.triangles.empty()) return out;
   sim::SelfContactDetector detector(frame.triangles, frame.pattern, thickness);
-  for (const sim::SelfContactPair& p : detector.find(frame.positions, thickness))
+  for (const sim::SelfContactPair& p : detector.find(frame.positions, thickness, vertexMask))
     out.depth = std::max(out.depth, (thickness - p.distance) / thickness);
   const auto crossings = detector.crossings(frame.positions);
   out.crossings = crossings.size();

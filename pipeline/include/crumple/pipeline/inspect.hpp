@@ -49,13 +49,16 @@ struct FrameMetrics {
 // (a vertex nearer than h to a triangle of another layer: (h - distance) / h;
 // an edge through such a triangle: 1 + how far it reaches past the plane / h,
 // so any crossing counts as more than a whole thickness), and how many edges
-// pass through a triangle. Every vertex counts, held or not; material
-// neighbours are one layer (sim::SelfContactDetector).
+// pass through a triangle. Every vertex counts, held or not, unless
+// `vertexMask` leaves it out of the pairs ((*vertexMask)[v] == 0; crossings
+// count every edge); material neighbours are one layer
+// (sim::SelfContactDetector).
 struct SelfPenetration {
   double depth = 0.0;  // in thicknesses
   std::size_t crossings = 0;
 };
-SelfPenetration selfPenetration(const cache::FrameRecord& frame, double thickness);
+SelfPenetration selfPenetration(const cache::FrameRecord& frame, double thickness,
+                                const std::vector<char>* vertexMask = nullptr);
 
 // The angle defect of a triangle mesh (Gauss-Bonnet's discrete curvature):
 // |2 pi - sum of the corner angles| at each vertex that is not on a boundary
