@@ -164,6 +164,7 @@ paper::CrumpleParams crumpleParamsOf(const io::HybridSpec& h) {
   p.maxSingularPerFrame = h.maxSingularPerFrame;
   p.remeshCooldown = h.remeshCooldown;
   p.maxEdgeStrain = h.maxEdgeStrain;
+  p.lagCatchUpSpeed = h.lagCatchUpSpeed;
   // Region invariants after every geometric step: always in debug builds,
   // on request (CRUMPLE_CHECK_INVARIANTS=1) in release builds.
   if (const char* env = std::getenv("CRUMPLE_CHECK_INVARIANTS"); env != nullptr && env[0] == '1')

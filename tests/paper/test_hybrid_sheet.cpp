@@ -218,6 +218,60 @@ TEST(HybridSheet, HandlesThatAskTooMuchLagInsteadOfStretchingThePaper) {
   EXPECT_LT(lag, 0.1 * kL);
 }
 
+// A handle the bound left behind comes back at most lagCatchUpSpeed faster
+// than its node moves: one node pulls its corner 10 mm beyond reach (the two
+// corners lag about 4.3 mm each), then the other node jumps 10 mm after it,
+// so the sheet could follow at once. With the catch-up the lagging corner creeps back; without
+// it (speed 0) it jumps the whole lag in one frame, and the sheet with it.
+TEST(HybridSheet, ALaggingHandleComesBackAtTheCatchUpSpeed) {
+  const std::vector<Vec2> corners{Vec2(0, 0), Vec2(kL, 0), Vec2(kL, kL), Vec2(0, kL)};
+  const InitialSheet sheet =
+      makeFlatSheet(kL, kL, corners, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
+  const auto node = [&](std::size_t k, double t) {
+    Vec3 x = sheet.mesh.vertices[static_cast<std::size_t>(sheet.handleVertices[k])].position;
+    if (k == 1) x.x() += 0.1 * kL * std::min(1.0, t / 0.2);
+    if (k == 0 && t > 1.0 / 3.0 + 1e-9) x.x() += 0.1 * kL;
+    return x;
+  };
+  const auto pins = [&](double t, std::vector<sim::Pin>& out) {
+    out.clear();
+    for (std::size_t k = 0; k < 2; ++k) out.push_back({sheet.handleVertices[k], node(k, t)});
+  };
+  // The largest excess of a handle's move over a frame beyond its node's
+  // move plus the catch-up once the reach is back (while the lag grows, the
+  // bound may move a handle away from its node), and the lag at the end.
+  const auto run = [&](double speed, double& excess, double& lagAtEnd) {
+    CrumpleParams params = checked();
+    params.lagCatchUpSpeed = speed;
+    HybridSheet hybrid(sheet.mesh, sim::Material{}, weightless(), params, 1);
+    std::vector<Vec3> last;
+    for (std::size_t k = 0; k < 2; ++k) last.push_back(node(k, 0.0));
+    excess = 0.0;
+    lagAtEnd = 0.0;
+    const double dt = 1.0 / 24.0;
+    for (int f = 0; f < 48; ++f) {
+      hybrid.advance(f * dt, dt, 2, pins, f + 1);
+      const mesh::SheetMesh& sp = hybrid.physical().mesh;
+      const LengthProjector lengths(sp.pattern, sp.triangles);
+      EXPECT_LE(lengths.strain(sp.positions).first, params.maxEdgeStrain + 1e-12) << "frame " << f;
+      for (std::size_t k = 0; k < 2; ++k) {
+        const Vec3 x = sp.positions[static_cast<std::size_t>(sheet.handleVertices[k])];
+        const double nodeMove = (node(k, (f + 1) * dt) - node(k, f * dt)).norm();
+        if (f >= 8) excess = std::max(excess, (x - last[k]).norm() - nodeMove - speed * dt);
+        last[k] = x;
+        if (f == 47) lagAtEnd = std::max(lagAtEnd, (x - node(k, (f + 1) * dt)).norm());
+      }
+    }
+  };
+  double excess = 0.0, lag = 0.0;
+  run(0.02, excess, lag);
+  EXPECT_LT(excess, 1e-4);  // within 0.1 mm of the allowed move on every frame
+  EXPECT_LT(lag, 1e-4);     // and back on its node (4.3 mm at 20 mm/s: 5 frames)
+  double jump = 0.0, lagAtOnce = 0.0;
+  run(0.0, jump, lagAtOnce);
+  EXPECT_GT(jump, 3e-3);  // the whole lag in one frame
+}
+
 // Hard cases for issue 6: the wrap of WrapCreatesParallelRulingsAndStaysIsometric
 // torn halfway through, from 9 points of its bottom edge in 3 directions
 // (through its curved region: the structure cases 1-2, and its flat ones),

@@ -108,8 +108,10 @@ TEST(CrumplingSamples, FirstSingularityHasTheShapeOfAFineMesh) {
 // kept (paper Table IV measures) on every frame of the shot, and the sheet
 // never passes through itself (without the crossing guard 122 edges did
 // from frame 73, where a 0.25 cm elastic reference does not even touch
-// itself). Where the guard stops it, up to 3.4 % of the edges are
-// compressed by more than 1 % (0.6 % without it).
+// itself). Where the guard stops it, up to 5.0 % of the edges are
+// compressed by more than 1 % (0.6 % without it; 3.4 % with the lagging
+// handles closing their lag in one step instead of at lag_catch_up_speed:
+// the jammed sheet stands still from frame 88 in another state).
 TEST(CrumplingSamples, CylinderFoldWrapIsSmoothThenTheBendMakesSingularVertices) {
   TempDir dir;
   const Shot shot = simulate("cylinder-fold", 102, std::nullopt, dir);
@@ -134,7 +136,7 @@ TEST(CrumplingSamples, CylinderFoldWrapIsSmoothThenTheBendMakesSingularVertices)
     }
     previousSingular = f.singularVertices.size();
     EXPECT_LE(m.cMean, 0.005) << "frame " << f.frame;
-    EXPECT_LE(m.nComp, 0.04) << "frame " << f.frame;
+    EXPECT_LE(m.nComp, 0.06) << "frame " << f.frame;
     EXPECT_EQ(pipeline::selfPenetration(f, 9e-5).crossings, 0u) << "frame " << f.frame;
     worstCMean = std::max(worstCMean, m.cMean);
     worstNComp = std::max(worstNComp, m.nComp);

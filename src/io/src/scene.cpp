@@ -875,7 +875,8 @@ class SceneParser {
                                                        "isometry_length_tolerance",
                                                        "max_singular_per_frame",
                                                        "remesh_cooldown",
-                                                       "max_edge_strain"};
+                                                       "max_edge_strain",
+                                                       "lag_catch_up_speed"};
     std::vector<std::string_view> allowed = {"type"};
     allowed.insert(allowed.end(), std::begin(kHybridKeys), std::end(kHybridKeys));
     r.allowOnly(allowed);
@@ -986,6 +987,9 @@ class SceneParser {
     // (0 turns the strain limit off).
     if (auto v = r.number("max_edge_strain"))
       h.maxEdgeStrain = inRange("max_edge_strain", *v, 0.0, 0.5, true);
+    // How fast a handle the bound left behind comes back (m/s; 0: at once).
+    if (auto v = r.number("lag_catch_up_speed"))
+      h.lagCatchUpSpeed = inRange("lag_catch_up_speed", *v, 0.0, 100.0, true);
   }
 
   std::string file_;

@@ -365,10 +365,12 @@ int HybridSheet::interiorSingularVertexCount() const {
 // fitting, S_P rebuilt from S_G, the isometry projection and (with
 // maxEdgeStrain) the strain limit. `stage` names
 // the stage running, for the error message when it throws.
-void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunction& pins, int frame,
-                                      int singularBudget, std::uint64_t& draw,
+void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunction& nodePins,
+                                      int frame, int singularBudget, std::uint64_t& draw,
                                       HybridStepStats& stats, const char*& stage) {
   Impl& m = *this;
+  // The handles on their nodes, a lagging one on its way back (catchUpPins).
+  const sim::PinFunction pins = m.catchUpPins(t, dt, nodePins);
   // The step's start, for the strain limit's carried start and for undoing
   // a structure change it cannot bound.
   const mesh::SheetMesh spBefore = m.params.maxEdgeStrain > 0.0 ? m.sp.mesh : mesh::SheetMesh{};
@@ -558,6 +560,9 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
     const double contactsBefore = stats.ms.contacts + stats.ms.selfContacts;
     m.undoStretchingGeometry(spBefore, sgBefore, elasticX, elasticV, positions, stats);
     m.limitStepStrain(spBefore, sgBefore, pinned, frame, positions, stats);
+    std::vector<sim::Pin> nodes;
+    nodePins(t + dt, nodes);
+    m.measureLags(nodes, positions, stats.strainLimit);
     // The contact rounds inside it count as contacts.
     stats.ms.strainLimit =
         msSince(t0) - (stats.ms.contacts + stats.ms.selfContacts - contactsBefore);

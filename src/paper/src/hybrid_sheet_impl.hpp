@@ -151,6 +151,19 @@ struct HybridSheet::Impl {
   // passes no more of S_P's edges through another layer than x0 had
   // (crossingGuard() > 0). Returns the fraction (1: the whole step).
   double keepElasticStepOutOfItself(const std::vector<Vec3>& x0, double dt);
+  // The pins of an animation step from t to t + dt, with every handle that
+  // lags behind its node (further from it than the node moves over the step)
+  // brought on at most params.lagCatchUpSpeed faster than its node, its
+  // tangent-plane pins moved with it.
+  sim::PinFunction catchUpPins(double t, double dt, const sim::PinFunction& pins) const;
+  // stats.lag and handleLags of x against the handles' nodes (the pins of
+  // the rig, not catchUpPins').
+  void measureLags(const std::vector<sim::Pin>& nodes, const std::vector<Vec3>& x,
+                   StrainLimitStats& s) const;
+  bool isHandle(int v) const {
+    return v >= 0 && static_cast<std::size_t>(v) < sg.vertices.size() &&
+           sg.vertices[static_cast<std::size_t>(v)].handle;
+  }
   void limitStepStrain(const mesh::SheetMesh& spBefore, const GeometricMesh& sgBefore,
                        const std::vector<sim::Pin>& pinned, int frame, std::vector<Vec3>& positions,
                        HybridStepStats& stats);
@@ -162,7 +175,7 @@ struct HybridSheet::Impl {
         out[static_cast<std::size_t>(p.vertex)] = 1;
     return out;
   }
-  void animationStep(double t, double dt, const sim::PinFunction& pins, int frame,
+  void animationStep(double t, double dt, const sim::PinFunction& nodePins, int frame,
                      int singularBudget, std::uint64_t& draw, HybridStepStats& stats,
                      const char*& stage);
 

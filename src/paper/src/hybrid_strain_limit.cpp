@@ -1,6 +1,7 @@
 // Paper stays paper after every animation step of the crumpling model:
 // HybridSheet's strain-limit stage (strain_limit.hpp, docs/CRUMPLING.md
 // "Strain limit"), with the contacts as constraints it keeps.
+#include <algorithm>
 #include <vector>
 
 #include "crumple/core/error.hpp"
@@ -110,6 +111,74 @@ double HybridSheet::Impl::keepElasticStepOutOfItself(const std::vector<Vec3>& x0
   return alpha;
 }
 
+// A lagging handle comes back along the straight line from where the step
+// finds it, at most lagCatchUpSpeed faster than its node moves; its
+// tangent-plane pins (listed after it, HandleRig::pins) keep their offsets
+// from it. Without this the first step whose structure lets the sheet follow
+// again closes the whole lag at once, and the sheet jumps (docs/CRUMPLING.md
+// "Popping").
+sim::PinFunction HybridSheet::Impl::catchUpPins(double t, double dt,
+                                                const sim::PinFunction& pins) const {
+  const double speed = params.lagCatchUpSpeed;
+  // Lags exist, and are reported, only under the strain limit.
+  if (!(speed > 0.0) || !(dt > 0.0) || !(params.maxEdgeStrain > 0.0)) return pins;
+  std::vector<sim::Pin> before, after;
+  pins(t, before);
+  pins(t + dt, after);
+  struct Path {
+    int vertex = -1;
+    Vec3 from, to;  // where the handle is at t, where it may be at t + dt
+  };
+  std::vector<Path> paths;
+  for (const sim::Pin& p : after) {
+    if (!isHandle(p.vertex) || static_cast<std::size_t>(p.vertex) >= sp.mesh.positions.size())
+      continue;
+    const Vec3 start = sp.mesh.positions[static_cast<std::size_t>(p.vertex)];
+    const auto node = std::find_if(before.begin(), before.end(),
+                                   [&](const sim::Pin& q) { return q.vertex == p.vertex; });
+    // A handle that takes hold in this step starts from where its vertex is.
+    const double nodeMove = node == before.end() ? 0.0 : (p.position - node->position).norm();
+    const double allowed = nodeMove + speed * dt;
+    const Vec3 gap = p.position - start;
+    const double distance = gap.norm();
+    if (distance <= allowed) continue;
+    paths.push_back({p.vertex, start, start + gap * (allowed / distance)});
+  }
+  if (paths.empty()) return pins;
+  return [pins, paths = std::move(paths), t, dt, this](double tau, std::vector<sim::Pin>& out) {
+    pins(tau, out);
+    const double s = std::clamp((tau - t) / dt, 0.0, 1.0);
+    Vec3 shift = Vec3::Zero();
+    for (sim::Pin& p : out) {
+      if (isHandle(p.vertex)) {
+        const auto path = std::find_if(paths.begin(), paths.end(),
+                                       [&](const Path& q) { return q.vertex == p.vertex; });
+        shift = path == paths.end() ? Vec3::Zero()
+                                    : Vec3(path->from + s * (path->to - path->from) - p.position);
+      }
+      p.position += shift;
+    }
+  };
+}
+
+// Each handle's lag behind its node, not behind the caught-up target the
+// step was given (catchUpPins).
+void HybridSheet::Impl::measureLags(const std::vector<sim::Pin>& nodes, const std::vector<Vec3>& x,
+                                    StrainLimitStats& s) const {
+  s.lag = 0.0;
+  s.lagVertex = -1;
+  s.handleLags.clear();
+  for (const sim::Pin& p : nodes) {
+    if (!isHandle(p.vertex) || static_cast<std::size_t>(p.vertex) >= x.size()) continue;
+    const double d = (x[static_cast<std::size_t>(p.vertex)] - p.position).norm();
+    s.handleLags.emplace_back(p.vertex, d);
+    if (d > s.lag) {
+      s.lag = d;
+      s.lagVertex = p.vertex;
+    }
+  }
+}
+
 // Paper stays paper after the isometry (strain_limit.hpp): S_P within
 // maxEdgeStrain, the handles on their targets or lagging; a remeshing that
 // leaves no configuration within the bound is undone.
@@ -144,11 +213,20 @@ void HybridSheet::Impl::limitStepStrain(const mesh::SheetMesh& spBefore,
   // Contacts as constraints of the limit: the failsafe's moves are kept
   // (KeepOut), and failsafe and limit alternate while the failsafe breaks
   // the bound again (alternating projections, von Neumann 1950).
+  // The failsafe moves vertex by vertex, and a collider pressing on a stack
+  // can push one layer through the next: it is cut back like the other
+  // stages (keepMoveOutOfItself), its half-spaces where it stopped.
   const auto contactRound = [&] {
     if (!m.contactsOn()) return false;
-    const auto more =
+    const std::vector<Vec3> before = positions;
+    auto more =
         keepOutOfContacts(m.contact, m.sp.mesh.triangles, m.sp.mesh.pattern, m.heldBy(pinned),
                           positions, &stats.ms.contacts, &stats.ms.selfContacts);
+    if (!more.empty()) {
+      const double alpha = m.keepMoveOutOfItself(before, positions);
+      if (!(alpha > 0.0)) more.clear();
+      for (KeepOut& k : more) k.point = positions[static_cast<std::size_t>(k.vertex)];
+    }
     keepOut.insert(keepOut.end(), more.begin(), more.end());
     return !more.empty();
   };

@@ -452,6 +452,14 @@ StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
   };
   if (s.maxBefore <= in.bound) return finish(x);
   s.ran = true;
+  // With the crossing guard on, no candidate may pass more of S_P's edges
+  // through another layer than the sheet it was given: a handle placed on
+  // its target, or a carried start, can put an edge through a layer that
+  // the projection's own guard then keeps there.
+  const std::size_t crossingsGiven = in.crossingGuard > 0.0 ? projector.crossings(x) : 0;
+  const auto outOfItself = [&](const std::vector<Vec3>& p) {
+    return !(in.crossingGuard > 0.0) || projector.crossings(p) <= crossingsGiven;
+  };
   const double aim = kAim * in.bound;
   std::vector<char> held(in.pattern.size(), 0);
   for (int h : in.handles) held[at(h)] = 1;
@@ -469,13 +477,14 @@ StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
     placeHandles(pinnedStep, in.handles, in.targets);
     const auto pinStats = projector.project(pinnedStep, pinHeld, aim, in.iterations);
     s.iterations += pinStats.iterations;
-    if (pinStats.maxAfter <= in.bound) return finish(std::move(pinnedStep));
+    if (pinStats.maxAfter <= in.bound && outOfItself(pinnedStep))
+      return finish(std::move(pinnedStep));
   }
   std::vector<Vec3> stepped = x;
   placeHandles(stepped, in.handles, in.targets);
   auto stats = projector.project(stepped, held, aim, in.iterations);
   s.iterations += stats.iterations;
-  if (stats.maxAfter < bestMax) {
+  if (stats.maxAfter < bestMax && outOfItself(stepped)) {
     best = std::move(stepped);
     bestMax = stats.maxAfter;
   }
@@ -492,7 +501,7 @@ StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
   placeHandles(carried, in.handles, in.targets);
   stats = projector.project(carried, held, aim, in.iterations);
   s.iterations += stats.iterations;
-  if (stats.maxAfter < bestMax) {
+  if (stats.maxAfter < bestMax && outOfItself(carried)) {
     best = std::move(carried);
     bestMax = stats.maxAfter;
     s.carried = true;
@@ -515,9 +524,10 @@ StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
     s.iterations += stats.iterations;
     s.droppedKeepOut = true;
   }
-  if (stats.maxAfter > in.bound) {
-    // Not even the carried step's start meets the bound: the best attempt.
-    if (stats.maxAfter < bestMax) {
+  if (stats.maxAfter > in.bound || !outOfItself(feasible)) {
+    // Not even the carried step's start meets the bound (or it passes
+    // through itself): the best attempt.
+    if (stats.maxAfter < bestMax && outOfItself(feasible)) {
       best = std::move(feasible);
       s.carried = true;
     }
@@ -538,7 +548,7 @@ StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
     stats = projector.projectTowards(towards, none, in.handles, in.targets, in.bound,
                                      kTowardsIterations);
     s.iterations += stats.iterations;
-    if (stats.maxAfter <= in.bound && sumLag(towards) < sumLag(feasible)) {
+    if (stats.maxAfter <= in.bound && sumLag(towards) < sumLag(feasible) && outOfItself(towards)) {
       s.carried = true;
       return finish(std::move(towards));
     }
@@ -555,7 +565,7 @@ StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
     placeHandles(trial, in.handles, where);
     stats = projector.project(trial, held, aim, in.iterations);
     s.iterations += stats.iterations;
-    if (stats.maxAfter <= in.bound) {
+    if (stats.maxAfter <= in.bound && outOfItself(trial)) {
       lo = mid;
       feasible = std::move(trial);
     } else {

@@ -47,7 +47,9 @@ class HandleRig {
   // Position of the handle's node at time t (world, metres).
   Vec3 target(std::size_t handle, double t) const;
   // Every pinned vertex and where it must be at time t: on its node, unless
-  // the nodes pull the sheet beyond its reach (reachExcess).
+  // the nodes pull the sheet beyond its reach (reachExcess). Each handle's
+  // pin comes first, its tangent-plane pins right after it (the crumpling
+  // model moves them with a handle that lags, paper::HybridSheet).
   void pins(double t, std::vector<sim::Pin>& out) const;
   // The sheet's reach (issue 9, stability): a rectangular sheet that cannot
   // tear cannot hold two handles farther apart than their pattern points

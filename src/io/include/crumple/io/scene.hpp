@@ -234,6 +234,7 @@ struct HybridSpec {
   int maxSingularPerFrame = 2;             // new singular vertices per frame at most
   int remeshCooldown = 3;                  // animation steps a remeshed region waits
   double maxEdgeStrain = 0.02;             // S_P's strain bound after every step (0: off)
+  double lagCatchUpSpeed = 0.02;           // m/s a lagging handle closes its lag at most
 };
 
 struct ModelSpec {

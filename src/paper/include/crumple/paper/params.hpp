@@ -76,6 +76,12 @@ struct CrumpleParams {
   // (docs/CRUMPLING.md, "Strain limit").
   double maxEdgeStrain = 0.02;
   int strainLimitIterations = 30;  // Levenberg-Marquardt steps per projection
+  // A handle the bound left behind its node closes that lag at most this
+  // much faster than its node moves (m/s), on a straight path from where it
+  // is: a finger that slipped comes back, it does not jump there in one step
+  // (docs/CRUMPLING.md "Popping"). 0: the whole lag at once. Only with the
+  // strain limit on (maxEdgeStrain > 0), which is what makes handles lag.
+  double lagCatchUpSpeed = 0.02;
 #ifdef NDEBUG
   bool checkInvariants = false;  // validate S_G and S_P after every geometric step
 #else
