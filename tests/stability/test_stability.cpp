@@ -53,6 +53,7 @@ struct Case {
   int timeoutFull = 0;    // s
   Bounds elastic, hybrid;
   std::string hybridKeys = {};  // more [model] keys for the crumpling model
+  int hybridShortLast = 0;      // the crumpling model's short clip, when longer (0: shortLast)
 };
 
 bool fullSuite() {
@@ -80,7 +81,11 @@ std::vector<Case> cases() {
   Bounds twistElastic = kElastic;
   twistElastic.cMean = 0.02;
   twistElastic.maxStrain = 0.30;
-  c.push_back({"Twist4Pi", "twist-4pi", 40, 0, false, 150, 600, twistElastic, kHybrid});
+  // The crumpling model runs the whole twist and untwist in the default suite
+  // (a few seconds): its layers pass through each other from frame 28, and
+  // a strain limit that kept them from passing further left 33 % from frame
+  // 44 on (docs/CRUMPLING.md "A lagging handle's way back").
+  c.push_back({"Twist4Pi", "twist-4pi", 40, 0, false, 150, 600, twistElastic, kHybrid, "", 120});
   // A pin that moves 5 cm within one substep drags its neighbours' edges:
   // ~30 % strain for a few substeps on the elastic model.
   Bounds jumpElastic = kElastic;
@@ -255,7 +260,8 @@ TEST_P(Stability, EndsFiniteValidAndBoundedOrWithAClearError) {
   std::string command = "env CRUMPLE_ASSETS=" + sourcePath("tests/stability") +
                         " timeout -s KILL " + std::to_string(timeout) + " " + CRUMPLE_BIN +
                         " simulate " + scene.string() + " --out " + (tmp / "out").string();
-  if (!full) command += " --frames 0-" + std::to_string(c.shortLast);
+  const int shortLast = hybrid && c.hybridShortLast > 0 ? c.hybridShortLast : c.shortLast;
+  if (!full) command += " --frames 0-" + std::to_string(shortLast);
   const auto start = std::chrono::steady_clock::now();
   CommandResult r = runCommand(command);
   Outcome o;
@@ -290,7 +296,7 @@ TEST_P(Stability, EndsFiniteValidAndBoundedOrWithAClearError) {
     ASSERT_TRUE(std::regex_search(o.output, m, clear)) << o.output;
     EXPECT_EQ(std::stoi(m[1]), o.lastFrame + 1) << o.output;
   } else if (!full) {
-    EXPECT_EQ(o.lastFrame, c.shortLast);
+    EXPECT_EQ(o.lastFrame, shortLast);
   }
   // The case built to pull beyond the sheet's reach says so in the summary,
   // naming the handle and the frames.

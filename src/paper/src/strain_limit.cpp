@@ -429,7 +429,12 @@ void mergeHandleLags(const std::vector<std::pair<int, double>>& from,
   }
 }
 
-StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
+namespace {
+
+// The stage above; with `outOfItselfFirst` no candidate is taken that passes
+// more of S_P's edges through another layer than `x` does.
+StrainLimitStats limitStrainOnce(const StrainLimitInput& in, std::vector<Vec3>& x,
+                                 bool outOfItselfFirst) {
   StrainLimitStats s;
   LengthProjector projector(in.pattern, in.triangles);
   projector.setKeepOut(in.keepOut);
@@ -456,9 +461,10 @@ StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
   // through another layer than the sheet it was given: a handle placed on
   // its target, or a carried start, can put an edge through a layer that
   // the projection's own guard then keeps there.
-  const std::size_t crossingsGiven = in.crossingGuard > 0.0 ? projector.crossings(x) : 0;
+  const bool guarded = outOfItselfFirst && in.crossingGuard > 0.0;
+  const std::size_t crossingsGiven = guarded ? projector.crossings(x) : 0;
   const auto outOfItself = [&](const std::vector<Vec3>& p) {
-    return !(in.crossingGuard > 0.0) || projector.crossings(p) <= crossingsGiven;
+    return !guarded || projector.crossings(p) <= crossingsGiven;
   };
   const double aim = kAim * in.bound;
   std::vector<char> held(in.pattern.size(), 0);
@@ -574,6 +580,22 @@ StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
   }
   s.carried = true;
   return finish(std::move(feasible));
+}
+
+}  // namespace
+
+StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
+  const std::vector<Vec3> given = in.crossingGuard > 0.0 ? x : std::vector<Vec3>{};
+  StrainLimitStats s = limitStrainOnce(in, x, true);
+  if (s.maxAfter <= in.bound || !(in.crossingGuard > 0.0)) return s;
+  // No candidate meets the bound without passing S_P further through
+  // itself: paper stays paper first (the crossings the sheet already had
+  // may then grow; the projections' own guard still holds within each).
+  x = given;
+  const int iterations = s.iterations;
+  s = limitStrainOnce(in, x, false);
+  s.iterations += iterations;
+  return s;
 }
 
 std::vector<KeepOut> keepOutOfContacts(const sim::ContactOptions& options,
