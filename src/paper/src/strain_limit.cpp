@@ -591,11 +591,15 @@ StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& x) {
   // No candidate meets the bound without passing S_P further through
   // itself: paper stays paper first (the crossings the sheet already had
   // may then grow; the projections' own guard still holds within each).
-  x = given;
-  const int iterations = s.iterations;
-  s = limitStrainOnce(in, x, false);
-  s.iterations += iterations;
-  return s;
+  std::vector<Vec3> second = given;
+  StrainLimitStats t = limitStrainOnce(in, second, false);
+  t.iterations += s.iterations;
+  if (t.maxAfter >= s.maxAfter) {
+    s.iterations = t.iterations;  // the first result stays: it is no worse
+    return s;
+  }
+  x = std::move(second);
+  return t;
 }
 
 std::vector<KeepOut> keepOutOfContacts(const sim::ContactOptions& options,

@@ -203,7 +203,10 @@ std::vector<KeepOut> keepOutOfContacts(const sim::ContactOptions& options,
 
 // Leaves `positions` within `bound` whenever the step's start was, holding
 // the handles on their targets if some start allows it and lagging them
-// otherwise; never raises the max strain it was given.
+// otherwise; never raises the max strain it was given. With a crossing
+// guard it takes no candidate that passes more edges through another layer
+// than `positions` did, unless none meets the bound that way (the bound
+// first).
 StrainLimitStats limitStrain(const StrainLimitInput& in, std::vector<Vec3>& positions);
 
 }  // namespace crumple::paper
