@@ -501,7 +501,8 @@ TEST(SceneModel, EveryKeyParsedAndConvertedToSI) {
       "isometry_length_tolerance = 1e-9\n"
       "max_singular_per_frame = 5\n"
       "remesh_cooldown = 0\n"
-      "max_edge_strain = 0.02\n");
+      "max_edge_strain = 0.02\n"
+      "lag_catch_up_speed = 0.05\n");
   const HybridSpec& h = s.model.hybrid;
   EXPECT_EQ(s.model.type, ModelSpec::Type::Hybrid);
   EXPECT_DOUBLE_EQ(h.rhoBound, 250.0);
@@ -520,6 +521,7 @@ TEST(SceneModel, EveryKeyParsedAndConvertedToSI) {
   EXPECT_EQ(h.maxSingularPerFrame, 5);
   EXPECT_EQ(h.remeshCooldown, 0);
   EXPECT_DOUBLE_EQ(h.maxEdgeStrain, 0.02);
+  EXPECT_DOUBLE_EQ(h.lagCatchUpSpeed, 0.05);  // m/s, not scaled by [scene] units
 }
 
 TEST(SceneModel, HysteresisFollowsTheta0) {
@@ -581,6 +583,8 @@ TEST(SceneErrors, Model) {
   expectError(head + "max_edge_strain = -0.01\n", 6, "model.max_edge_strain", {"[0, 0.5)"});
   expectError(head + "max_edge_strain = 2\n", 6, "model.max_edge_strain", {"[0, 0.5)", "got 2"});
   expectError(head + "max_edge_strain = nan\n", 6, "model.max_edge_strain", {"finite"});
+  expectError(head + "lag_catch_up_speed = -0.01\n", 6, "model.lag_catch_up_speed", {"[0, 100)"});
+  expectError(head + "lag_catch_up_speed = inf\n", 6, "model.lag_catch_up_speed", {"finite"});
   expectError(head + "theta_rest = -0.1\n", 6, "model.theta_rest", {"[0, pi)"});
   expectError(head + "theta_rest = 3.2\n", 6, "model.theta_rest", {"[0, pi)"});
   expectError(head + "damage = -1\n", 6, "model.damage", {">= 0"});
