@@ -253,9 +253,10 @@ void HybridSheet::Impl::limitStepStrain(const mesh::SheetMesh& spBefore,
     ++stats.undoneByBound;
     keepOut.clear();  // its vertices were the undone S_P's
     if (m.sp.mesh.triangles == spBefore.triangles && m.sp.mesh.pattern == spBefore.pattern) {
+      // From the step's start as it was, its handles where they were: put
+      // on their targets at once they could pass edges through another
+      // layer, which the limit would then keep (the limit moves them on).
       positions = spBefore.positions;
-      for (std::size_t h = 0; h < handles.size(); ++h)
-        positions[static_cast<std::size_t>(handles[h])] = targets[h];
       contactRound();
       again();
       stats.geometric.notes.push_back(
