@@ -72,11 +72,13 @@ void printStepTrace(int level, int frame, const GeometricMesh& sg, const Physica
   std::fprintf(
       stderr,
       "[geometry]   max speed %.3g m/s, isometry displacement %.3g m (Phase I %d, sweeps %d), "
-      "halvings %d, max hinge %.3f rad at (%.2f, %.2f cm) [%.3f %.3f %.3f], worst S_P triangle "
+      "Newton %d (%d solves), halvings %d, max hinge %.3f rad at (%.2f, %.2f cm) [%.3f %.3f %.3f], "
+      "worst S_P triangle "
       "%.3g",
       vmax, stats.isometry.meanDisplacement, stats.isometry.phaseOneIterations,
-      stats.isometry.lengthSweeps, stats.elastic.halvings, maxHinge, 100 * maxHingeAt.x(),
-      100 * maxHingeAt.y(), hinge[0], hinge[1], hinge[2], quality);
+      stats.isometry.lengthSweeps, stats.elastic.newtonIterations, stats.elastic.solves,
+      stats.elastic.halvings, maxHinge, 100 * maxHingeAt.x(), 100 * maxHingeAt.y(), hinge[0],
+      hinge[1], hinge[2], quality);
   for (int k : worst) {
     const Vec2& p = sp.mesh.pattern[static_cast<std::size_t>(k)];
     std::fprintf(stderr, " %d%s(%.2f, %.2f cm)", k,
