@@ -5,7 +5,7 @@
 // length error (c_mean, paper Table IV) each reaches. Medians of `--runs`
 // repetitions measured in one process, so ratios compare like with like.
 //
-//   build/bench/bench_hybrid [--runs 3] [--frames N] [sample ...]
+//   build/bench/bench_hybrid [--runs 3] [--frames N] [--edges 1,0.5,0.25] [sample ...]
 //
 // A sample the model cannot finish is reported up to its last good frame.
 #include <algorithm>
@@ -49,7 +49,8 @@ Run fromSummary(const std::string& outDir, const std::string& error) {
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   Run run;
   run.error = error;
-  for (const char* stage : {"elastic", "geometric", "cones", "rebuild", "isometry"}) {
+  for (const char* stage : {"elastic", "geometric", "cones", "rebuild", "isometry", "strain limit",
+                            "contacts", "contact check", "tear", "sound events"}) {
     const double ms = jsonNumber(text, stage);
     if (ms > 0.0) run.msPerFrame[stage] = ms, run.total += ms;
   }
@@ -101,6 +102,7 @@ Run median(std::vector<Run> runs) {
 int main(int argc, char** argv) {
   int runs = 3;
   int lastFrame = -1;
+  std::vector<double> edgesCm = {1.0, 0.5, 0.25};
   std::vector<std::string> samples;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -108,9 +110,27 @@ int main(int argc, char** argv) {
       runs = std::max(1, std::atoi(argv[++i]));
     } else if (a == "--frames" && i + 1 < argc) {
       lastFrame = std::atoi(argv[++i]);
+    } else if (a == "--edges" && i + 1 < argc) {
+      // The fixed elastic meshes' edge lengths (cm), comma-separated.
+      edgesCm.clear();
+      std::string list = argv[++i];
+      for (std::size_t at = 0; at <= list.size();) {
+        const std::size_t comma = std::min(list.find(',', at), list.size());
+        const double edge = std::atof(list.substr(at, comma - at).c_str());
+        if (!(edge > 0.0)) {
+          std::fprintf(stderr, "bench_hybrid: --edges wants positive lengths in cm, got '%s'\n",
+                       list.c_str());
+          return 2;
+        }
+        edgesCm.push_back(edge);
+        at = comma + 1;
+      }
     } else if (a == "--help" || a == "-h") {
       std::puts(
-          "bench_hybrid [--runs 3] [--frames LAST] [sample ...]  (default: every hybrid sample)");
+          "bench_hybrid [--runs 3] [--frames LAST] [--edges 1,0.5,0.25] [sample ...]\n"
+          "  (default: cylinder-fold first-singularity moebius unload crumple; the elastic\n"
+          "  model on fixed meshes of each --edges length in cm, over the frames the\n"
+          "  crumpling model ran)");
       return 0;
     } else {
       samples.push_back(a);
@@ -140,7 +160,7 @@ int main(int argc, char** argv) {
                 ms(h, "isometry"), h.total, h.error.empty() ? "" : "  (stopped early)");
     // The plain elastic model on fixed meshes, over the frames the hybrid ran.
     const int frames = base.frameStart + std::max(h.frames, 1) - 1;
-    for (const double edgeCm : {1.0, 0.5, 0.25}) {
+    for (const double edgeCm : edgesCm) {
       io::SceneSpec elastic = base;
       elastic.model.type = io::ModelSpec::Type::Elastic;
       elastic.sheet.maxEdge = edgeCm / 100.0;
