@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "crumple/core/error.hpp"
+#include "crumple/core/geometry2d.hpp"
 #include "crumple/paper/compression.hpp"
 
 namespace crumple::paper {
@@ -41,8 +42,6 @@ void requireFinite(const Vec2& v, const char* what) {
 void requireFinite(double v, const char* what) {
   if (!std::isfinite(v)) throw NumericalError(kStage, std::string(what) + " is not finite");
 }
-
-double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 Vec2 rotate(const Vec2& v, double angle) {
   const double c = std::cos(angle);

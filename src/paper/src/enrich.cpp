@@ -18,8 +18,6 @@ namespace {
 
 using Weights = std::array<double, 4>;
 
-double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
-
 const Vec2& patternOf(const GeometricMesh& g, int v) {
   return g.vertices[static_cast<std::size_t>(v)].pattern;
 }

@@ -4,14 +4,13 @@
 #include <numeric>
 #include <vector>
 
+#include "crumple/core/geometry2d.hpp"
 #include "crumple/paper/compression.hpp"
 #include "crumple/paper/geometric_step.hpp"
 
 namespace crumple::paper {
 
 namespace {
-
-double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 int oppositeVertex(const GeometricFace& f, int a, int b) {
   for (int k = 0; k < 3; ++k) {

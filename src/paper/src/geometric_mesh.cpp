@@ -6,13 +6,11 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "crumple/core/geometry2d.hpp"
+
 namespace crumple::paper {
 
-namespace {
-
-double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
-
-}  // namespace
+namespace {}  // namespace
 
 std::vector<GeometricEdge> buildEdges(const GeometricMesh& g) {
   // Half-edges sorted by (min, max) vertex pair, then by face: one

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "crumple/core/geometry2d.hpp"
 #include "crumple/paper/geometric_step.hpp"
 #include "region_tools.hpp"
 
@@ -18,8 +19,6 @@ std::array<int, 2> facesOf(const EdgeMap& edges, int a, int b) {
   const auto it = edges.find({std::min(a, b), std::max(a, b)});
   return it == edges.end() ? std::array<int, 2>{-1, -1} : it->second;
 }
-
-double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 // Appends the flat triangles of a curved cell between rulings r0 and r1
 // (a quad is cut along its shorter pattern diagonal).

@@ -1,0 +1,533 @@
+// The strip of imaginary rulings (paper Appendices A-B; thesis 2.4.3).
+//
+// The imaginary rulings of the paper are handled as a pencil of chords of
+// the flat region F in the pattern: parallel chords along v-perp (case c1,
+// both borders on dS) or chords through a singular vertex s (case c2). The
+// strip of Appendix A is the run of chords around the compressed triangle
+// that go from dS to dS without meeting a constrained border or a vertex
+// that is not on dS; its extreme chords are r_lim1 and r_lim2 (Appendix B).
+#include "strip.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <optional>
+#include <span>
+
+#include "crumple/core/geometry2d.hpp"
+
+namespace crumple::paper::detail {
+
+namespace {
+
+struct ChordEnd {
+  Vec2 p = Vec2::Zero();
+  int loopEdge = -1;  // loop edge crossed (p strictly inside it), or -1
+  int vertex = -1;    // the loop vertex the chord ends at, or -1
+};
+
+struct Chord {
+  double param = 0.0;
+  ChordEnd a;  // the -dir end (parallel) or the apex (conical)
+  ChordEnd b;  // the +dir end
+};
+
+struct PencilFrame {
+  Vec2 point;
+  Vec2 dir;
+};
+
+PencilFrame chordLine(const GeometricMesh& g, const Pencil& pencil, double param) {
+  if (pencil.apex < 0) {
+    const Vec2 n(-pencil.dir.y(), pencil.dir.x());
+    return {pencil.origin + param * n, pencil.dir};
+  }
+  const double c = std::cos(param);
+  const double s = std::sin(param);
+  const Vec2 d(c * pencil.dir.x() - s * pencil.dir.y(), s * pencil.dir.x() + c * pencil.dir.y());
+  return {g.vertices[static_cast<std::size_t>(pencil.apex)].pattern, d};
+}
+
+double paramOf(const GeometricMesh& g, const Pencil& pencil, const Vec2& p) {
+  if (pencil.apex < 0) {
+    const Vec2 n(-pencil.dir.y(), pencil.dir.x());
+    return n.dot(p - pencil.origin);
+  }
+  const Vec2 d = p - g.vertices[static_cast<std::size_t>(pencil.apex)].pattern;
+  return std::atan2(cross2(pencil.dir, d), pencil.dir.dot(d));
+}
+
+// Crossings of the chord line with the loop, sorted along the line. Vertices
+// exactly on the line are reported as vertex ends.
+std::vector<std::pair<double, ChordEnd>> crossings(const GeometricMesh& g, const Loop& loop,
+                                                   const PencilFrame& line, double tol) {
+  std::vector<std::pair<double, ChordEnd>> out;
+  const Vec2 n(-line.dir.y(), line.dir.x());
+  const std::size_t m = loop.size();
+  std::vector<double> side(m);
+  for (std::size_t k = 0; k < m; ++k) {
+    side[k] = n.dot(g.vertices[static_cast<std::size_t>(loop.v[k])].pattern - line.point);
+    if (std::abs(side[k]) <= tol) side[k] = 0.0;
+  }
+  for (std::size_t k = 0; k < m; ++k) {
+    const Vec2& pa = g.vertices[static_cast<std::size_t>(loop.v[k])].pattern;
+    if (side[k] == 0.0) {
+      ChordEnd e;
+      e.p = pa;
+      e.vertex = static_cast<int>(k);
+      out.emplace_back(line.dir.dot(pa - line.point), e);
+      continue;
+    }
+    const double s1 = side[(k + 1) % m];
+    if (s1 != 0.0 && (side[k] > 0.0) != (s1 > 0.0)) {
+      const Vec2& pb = g.vertices[static_cast<std::size_t>(loop.next(k))].pattern;
+      const double u = side[k] / (side[k] - s1);
+      ChordEnd e;
+      e.p = pa + u * (pb - pa);
+      e.loopEdge = static_cast<int>(k);
+      out.emplace_back(line.dir.dot(e.p - line.point), e);
+    }
+  }
+  std::sort(out.begin(), out.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  return out;
+}
+
+bool loopEdgeOnBoundary(const Loop& loop, int k) {
+  return loop.across[static_cast<std::size_t>(k)] < 0;
+}
+
+bool vertexEndFree(const GeometricMesh& g, const Loop& loop, int k) {
+  return g.vertices[static_cast<std::size_t>(loop.v[static_cast<std::size_t>(k)])].onBoundary;
+}
+
+struct Context {
+  const GeometricMesh& g;
+  const Loop& loop;
+  const std::vector<int>& interior;  // region vertices not on the loop
+  double tol;
+};
+
+// The chord at `param` if it runs from dS to dS (or from the apex to dS)
+// through the region without touching a constrained border, else nullopt.
+std::optional<Chord> evaluateChord(const Context& c, const Pencil& pencil, double param,
+                                   const char** why = nullptr) {
+  // Returns no chord, saying why when asked (for the remeshing notes).
+  const auto fail = [why](const char* reason) -> std::optional<Chord> {
+    if (why != nullptr) *why = reason;
+    return std::nullopt;
+  };
+  const PencilFrame line = chordLine(c.g, pencil, param);
+  auto hits = crossings(c.g, c.loop, line, c.tol);
+  const auto endOk = [&](const ChordEnd& e) {
+    if (e.vertex >= 0) return vertexEndFree(c.g, c.loop, e.vertex);
+    return loopEdgeOnBoundary(c.loop, e.loopEdge);
+  };
+  Chord chord;
+  chord.param = param;
+  if (pencil.apex < 0) {
+    // The chord through `origin`-side: the pair of consecutive hits whose
+    // midpoint is inside the region and closest to the pencil's origin line.
+    // With a simple region the valid chord has exactly two hits.
+    if (hits.size() != 2) return fail("the chord crosses the region's border more than twice");
+    chord.a = hits[0].second;
+    chord.b = hits[1].second;
+    if (!endOk(chord.a) || !endOk(chord.b)) return fail("the chord ends on a constrained border");
+  } else {
+    // From the apex forwards to the first hit that is not the apex itself.
+    const int apexLoop = static_cast<int>(std::find(c.loop.v.begin(), c.loop.v.end(), pencil.apex) -
+                                          c.loop.v.begin());
+    std::optional<ChordEnd> first;
+    for (const auto& [t, e] : hits) {
+      if (e.vertex == apexLoop) continue;
+      if (e.loopEdge >= 0 && (e.loopEdge == apexLoop ||
+                              (e.loopEdge + 1) % static_cast<int>(c.loop.size()) == apexLoop)) {
+        continue;
+      }
+      if (t <= c.tol) continue;
+      first = e;
+      break;
+    }
+    if (!first) return fail("the chord from the apex leaves the region at once");
+    if (!endOk(*first)) return fail("the chord from the apex ends on a constrained border");
+    chord.a.p = line.point;
+    chord.a.vertex = apexLoop;
+    chord.b = *first;
+  }
+  // A chord along a loop edge (the strip reaches a straight piece of the
+  // border parallel to it): valid as the strip's limit when on dS.
+  if (chord.a.vertex >= 0 && chord.b.vertex >= 0) {
+    const int m = static_cast<int>(c.loop.size());
+    const int i = chord.a.vertex;
+    const int j = chord.b.vertex;
+    if ((i + 1) % m == j)
+      return loopEdgeOnBoundary(c.loop, i) ? std::optional<Chord>(chord)
+                                           : fail("the chord runs along a constrained border");
+    if ((j + 1) % m == i)
+      return loopEdgeOnBoundary(c.loop, j) ? std::optional<Chord>(chord)
+                                           : fail("the chord runs along a constrained border");
+  }
+  if (!insideLoop(c.g, c.loop, 0.5 * (chord.a.p + chord.b.p)))
+    return fail("the chord runs outside the region");
+  // No vertex of the region may lie on the chord (a singular or handle
+  // vertex inside the strip, Appendix B: "no singular point inside").
+  const Vec2 d = chord.b.p - chord.a.p;
+  const double len2 = d.squaredNorm();
+  for (int v : c.interior) {
+    const Vec2& p = c.g.vertices[static_cast<std::size_t>(v)].pattern;
+    const double t = (p - chord.a.p).dot(d) / len2;
+    if (t > 0.0 && t < 1.0 &&
+        std::abs(cross2(d, p - chord.a.p)) / std::sqrt(len2) <= 10.0 * c.tol) {
+      return fail("a vertex inside the region lies on the chord");
+    }
+  }
+  return chord;
+}
+
+// Appendix A-B: the run of valid chords around parameter 0, bounded by the
+// extreme rulings r_lim1 and r_lim2. Returns the sorted chord parameters.
+std::vector<double> stripParameters(const Context& c, const Pencil& pencil, double spacing,
+                                    const char** why = nullptr) {
+  std::vector<double> events;
+  const auto addEvent = [&](int v) {
+    if (v == pencil.apex) return;
+    events.push_back(paramOf(c.g, pencil, c.g.vertices[static_cast<std::size_t>(v)].pattern));
+  };
+  for (int v : c.loop.v) addEvent(v);
+  for (int v : c.interior) addEvent(v);
+  const double limit = pencil.apex < 0 ? 1e300 : std::numbers::pi * 0.999;
+  events.push_back(-limit);
+  events.push_back(limit);
+  std::sort(events.begin(), events.end());
+  events.erase(std::unique(events.begin(), events.end(),
+                           [&](double x, double y) { return std::abs(x - y) <= c.tol; }),
+               events.end());
+  // The interval holding parameter 0 (an event at 0 is fine: start just above it).
+  std::size_t i0 = 0;
+  while (i0 + 2 < events.size() && events[i0 + 1] <= 0.0) ++i0;
+  const auto intervalValid = [&](std::size_t i) {
+    return evaluateChord(c, pencil, 0.5 * (events[i] + events[i + 1])).has_value();
+  };
+  if (!intervalValid(i0)) {
+    evaluateChord(c, pencil, 0.5 * (events[i0] + events[i0 + 1]), why);
+    return {};
+  }
+  const auto eventOk = [&](double param) { return evaluateChord(c, pencil, param).has_value(); };
+  // Extend up.
+  std::size_t hiInterval = i0;
+  double hi = 0.0;
+  for (;;) {
+    const double e = events[hiInterval + 1];
+    if (hiInterval + 2 >= events.size()) {
+      hi = 0.5 * (events[hiInterval] + e);
+      break;
+    }
+    if (!eventOk(e)) {  // pull back into the interval
+      hi = e - 0.35 * (e - events[hiInterval]);
+      break;
+    }
+    if (!intervalValid(hiInterval + 1)) {
+      hi = e;
+      break;
+    }
+    ++hiInterval;
+  }
+  std::size_t loInterval = i0;
+  double lo = 0.0;
+  for (;;) {
+    const double e = events[loInterval];
+    if (loInterval == 0) {
+      lo = 0.5 * (e + events[loInterval + 1]);
+      break;
+    }
+    if (!eventOk(e)) {
+      lo = e + 0.35 * (events[loInterval + 1] - e);
+      break;
+    }
+    if (!intervalValid(loInterval - 1)) {
+      lo = e;
+      break;
+    }
+    --loInterval;
+  }
+  if (!(hi > lo)) return {};
+  std::vector<double> params{lo};
+  for (double e : events) {
+    if (e > lo + c.tol && e < hi - c.tol) params.push_back(e);
+  }
+  params.push_back(hi);
+  // Fill so consecutive ruling endpoints are at most `spacing` apart along
+  // the boundary (the ruling density rho_bound, Appendix B).
+  std::vector<double> filled{params.front()};
+  for (std::size_t k = 0; k + 1 < params.size(); ++k) {
+    const auto c0 = evaluateChord(c, pencil, params[k]);
+    const auto c1 = evaluateChord(c, pencil, params[k + 1]);
+    int pieces = 1;
+    if (c0 && c1) {
+      const double gap = std::max((c1->a.p - c0->a.p).norm(), (c1->b.p - c0->b.p).norm());
+      pieces = std::max(1, static_cast<int>(std::ceil(gap / spacing - 1e-9)));
+    }
+    for (int j = 1; j <= pieces; ++j) {
+      filled.push_back(params[k] + (params[k + 1] - params[k]) * j / pieces);
+    }
+  }
+  return filled;
+}
+
+}  // namespace
+
+// Appendix A: walks from the compressed triangle's centroid along +-dir to
+// the region's border and classifies it (Fig. 6 b-d).
+Border findBorder(const GeometricMesh& g, const Loop& loop, const Vec2& origin, const Vec2& dir,
+                  double tol) {
+  const auto hits = crossings(g, loop, {origin, dir}, tol);
+  Border border;
+  for (const auto& [t, e] : hits) {
+    if (t <= tol) continue;
+    border.hit = e.p;
+    if (e.vertex >= 0) {
+      // Through a vertex: free if on dS, otherwise treat the next edge.
+      border.kind = g.vertices[static_cast<std::size_t>(loop.v[static_cast<std::size_t>(e.vertex)])]
+                            .onBoundary
+                        ? Border::Kind::Free
+                        : Border::Kind::None;
+      return border;
+    }
+    border.loopEdge = e.loopEdge;
+    const int across = loop.across[static_cast<std::size_t>(e.loopEdge)];
+    if (across < 0) {
+      border.kind = Border::Kind::Free;
+    } else if (g.regions[static_cast<std::size_t>(g.faces[static_cast<std::size_t>(across)].region)]
+                   .type == mesh::RegionType::Flat) {
+      border.kind = Border::Kind::FlatFlat;
+    } else {
+      border.kind = Border::Kind::Curved;
+    }
+    return border;
+  }
+  return border;
+}
+
+// Appendix B: remeshes region F into the flat parts outside the strip and a
+// curved region of the strip's chords.
+StripResult remeshStrip(GeometricMesh& g, int region, const Pencil& pencil,
+                        const CrumpleParams& params, const BoundaryPosition& boundary) {
+  const EdgeMap edges = edgeMap(g);
+  const auto loopOpt = regionLoop(g, region, edges);
+  if (!loopOpt) return {false, "region has holes or pinches"};
+  const Loop& loop = *loopOpt;
+  std::vector<int> interior;
+  {
+    std::vector<char> onLoop(g.vertices.size(), 0);
+    for (int v : loop.v) onLoop[static_cast<std::size_t>(v)] = 1;
+    for (const GeometricFace& f : g.faces) {
+      if (f.region != region) continue;
+      for (int k = 0; k < f.size(); ++k) {
+        if (!onLoop[static_cast<std::size_t>(f.v[k])]) {
+          interior.push_back(f.v[k]);
+          onLoop[static_cast<std::size_t>(f.v[k])] = 1;
+        }
+      }
+    }
+  }
+  const double scale = std::sqrt(outlineArea(g));
+  const Context ctx{g, loop, interior, 1e-10 * scale};
+  const char* noStrip = "";
+  const std::vector<double> stripParams =
+      stripParameters(ctx, pencil, 1.0 / params.rhoBound, &noStrip);
+  if (stripParams.size() < 2)
+    return {false, std::string("no strip of free rulings around the compressed triangle (") +
+                       noStrip + ")"};
+  std::vector<Chord> chords;
+  for (double p : stripParams) {
+    auto c = evaluateChord(ctx, pencil, p);
+    if (!c) return {false, "a ruling of the strip met a constrained border"};
+    chords.push_back(*c);
+  }
+  // Minimum strip width: a strip thinner than a tenth of the ruling spacing
+  // would make slivers; let the simulation deform further first.
+  const double width = std::max((chords.back().a.p - chords.front().a.p).norm(),
+                                (chords.back().b.p - chords.front().b.p).norm());
+  if (width < 0.1 / params.rhoBound) return {false, "strip too narrow"};
+  // Ruling ends at least half the ruling spacing apart on both borders (or
+  // one shared vertex, a fan's apex): a conical pencil spaced at 1/rho_bound
+  // on its far border crowds its near border, and ends millimetres apart
+  // make sliver cells that stall the elastic solve. The limit rulings stay.
+  // Chord ends within a quarter of the ruling spacing of a loop vertex move
+  // onto it (a new vertex beside an existing one would make slivers); a chord
+  // that then runs along part of a loop edge is no ruling and is dropped.
+  {
+    const double snap = 0.25 / params.rhoBound;
+    const int m = static_cast<int>(loop.size());
+    const auto snapEnd = [&](ChordEnd& e) {
+      if (e.vertex >= 0) return;
+      const int a = e.loopEdge;
+      const int b = (a + 1) % m;
+      for (int k : {a, b}) {
+        const Vec2& p =
+            g.vertices[static_cast<std::size_t>(loop.v[static_cast<std::size_t>(k)])].pattern;
+        if ((e.p - p).norm() < snap) {
+          e.p = p;
+          e.vertex = k;
+          e.loopEdge = -1;
+          return;
+        }
+      }
+    };
+    const auto alongLoop = [&](const ChordEnd& x, const ChordEnd& y) {
+      if (x.loopEdge >= 0 && y.loopEdge >= 0) return x.loopEdge == y.loopEdge;
+      const ChordEnd& onEdge = x.loopEdge >= 0 ? x : y;
+      const ChordEnd& atVertex = x.loopEdge >= 0 ? y : x;
+      if (onEdge.loopEdge < 0) return false;  // both at vertices: handled by evaluateChord
+      return atVertex.vertex == onEdge.loopEdge || atVertex.vertex == (onEdge.loopEdge + 1) % m;
+    };
+    std::vector<Chord> kept;
+    for (Chord c : chords) {
+      snapEnd(c.a);
+      snapEnd(c.b);
+      if (c.a.vertex >= 0 && c.a.vertex == c.b.vertex) continue;
+      if (alongLoop(c.a, c.b)) continue;
+      kept.push_back(c);
+    }
+    chords = std::move(kept);
+    if (chords.size() < 2) return {false, "strip has fewer than two distinct rulings"};
+  }
+  {
+    const double minGap = 0.5 / params.rhoBound;
+    const auto apart = [&](const ChordEnd& x, const ChordEnd& y) {
+      const double d = (x.p - y.p).norm();
+      return d < ctx.tol || d >= minGap;
+    };
+    const auto spaced = [&](const Chord& x, const Chord& y) {
+      return apart(x.a, y.a) && apart(x.b, y.b);
+    };
+    std::vector<Chord> kept{chords.front()};
+    for (std::size_t k = 1; k + 1 < chords.size(); ++k) {
+      if (spaced(kept.back(), chords[k]) && spaced(chords[k], chords.back()))
+        kept.push_back(chords[k]);
+    }
+    if (chords.size() > 1) kept.push_back(chords.back());
+    chords = std::move(kept);
+  }
+
+  // Vertices for the chord ends: existing loop vertices, or new ones on dS
+  // edges (several per edge are kept in order along it).
+  std::map<int, std::vector<std::pair<double, int>>> onEdge;  // loop edge -> (u, new vertex)
+  const auto endVertex = [&](const ChordEnd& e) {
+    if (e.vertex >= 0) return loop.v[static_cast<std::size_t>(e.vertex)];
+    const int a = loop.v[static_cast<std::size_t>(e.loopEdge)];
+    const int b = loop.next(static_cast<std::size_t>(e.loopEdge));
+    const Vec2& pa = g.vertices[static_cast<std::size_t>(a)].pattern;
+    const Vec2& pb = g.vertices[static_cast<std::size_t>(b)].pattern;
+    const double u = (e.p - pa).norm() / (pb - pa).norm();
+    // Snap onto an endpoint closer than a quarter of the ruling spacing (a
+    // new vertex beside an existing one would make sliver triangles).
+    const double snap = 0.25 / params.rhoBound;
+    if ((e.p - pa).norm() < snap) return a;
+    if ((e.p - pb).norm() < snap) return b;
+    const int v = addBoundaryVertex(g, a, b, e.p, boundary);
+    onEdge[e.loopEdge].emplace_back(u, v);
+    return v;
+  };
+  std::vector<Ruling> rulings;
+  for (const Chord& c : chords) {
+    Ruling r;
+    r.a = endVertex(c.a);
+    r.b = endVertex(c.b);
+    if (r.a == r.b) return {false, "degenerate ruling"};
+    if (!rulings.empty() && rulings.back().a == r.a && rulings.back().b == r.b) continue;
+    rulings.push_back(r);
+  }
+  // Drop rulings that would make a cell of (near) zero area, e.g. two chord
+  // ends snapped onto one vertex next to a cone apex.
+  {
+    const auto P = [&](int v) -> const Vec2& {
+      return g.vertices[static_cast<std::size_t>(v)].pattern;
+    };
+    const auto cellArea = [&](const Ruling& r0, const Ruling& r1) {
+      std::vector<int> poly{r0.a, r1.a, r1.b, r0.b};
+      poly.erase(std::unique(poly.begin(), poly.end()), poly.end());
+      if (poly.size() > 1 && poly.front() == poly.back()) poly.pop_back();
+      double area = 0.0;
+      for (std::size_t k = 0; k < poly.size(); ++k)
+        area += cross2(P(poly[k]), P(poly[(k + 1) % poly.size()]));
+      return std::abs(0.5 * area);
+    };
+    const double minArea = 1e-4 / (params.rhoBound * params.rhoBound);
+    std::vector<Ruling> kept;
+    for (std::size_t k = 0; k < rulings.size(); ++k) {
+      if (!kept.empty() && cellArea(kept.back(), rulings[k]) < minArea) {
+        if (k + 1 == rulings.size() && kept.size() > 1)
+          kept.back() = rulings[k];  // keep the limit ruling
+        continue;
+      }
+      kept.push_back(rulings[k]);
+    }
+    rulings = std::move(kept);
+  }
+  if (rulings.size() < 2) return {false, "strip has fewer than two distinct rulings"};
+  // The loop with the new vertices.
+  std::vector<int> newLoop;
+  for (std::size_t k = 0; k < loop.size(); ++k) {
+    newLoop.push_back(loop.v[k]);
+    auto it = onEdge.find(static_cast<int>(k));
+    if (it == onEdge.end()) continue;
+    auto list = it->second;
+    std::sort(list.begin(), list.end());
+    for (const auto& [u, v] : list) newLoop.push_back(v);
+  }
+  const auto position = [&](int v) {
+    return static_cast<std::size_t>(std::find(newLoop.begin(), newLoop.end(), v) - newLoop.begin());
+  };
+  // The loop path from x forwards to y (inclusive).
+  const auto path = [&](int x, int y) {
+    std::vector<int> out;
+    std::size_t k = position(x);
+    for (std::size_t n = 0; n <= newLoop.size(); ++n) {
+      out.push_back(newLoop[k]);
+      if (newLoop[k] == y) break;
+      k = (k + 1) % newLoop.size();
+    }
+    return out;
+  };
+  const auto contains = [](const std::vector<int>& list, int v) {
+    return std::find(list.begin(), list.end(), v) != list.end();
+  };
+  // Every loop vertex strictly between consecutive rulings must be absent,
+  // or the strip cells would not be quads/triangles.
+  std::vector<std::vector<int>> sides;
+  for (int end = 0; end < 2; ++end) {
+    const Ruling& r = end == 0 ? rulings.front() : rulings[rulings.size() - 1];
+    const Ruling& inner = end == 0 ? rulings[1] : rulings[rulings.size() - 2];
+    const int innerProbe = inner.b != r.b ? inner.b : inner.a;
+    std::vector<int> p1 = path(r.a, r.b);
+    std::vector<int> p2 = path(r.b, r.a);
+    std::vector<int>& side = contains(p1, innerProbe) ? p2 : p1;
+    if (side.size() >= 3) sides.push_back(side);
+  }
+  // Check the strip cells: loop path between consecutive ruling ends must be
+  // a single edge (or the apex).
+  for (std::size_t k = 0; k + 1 < rulings.size(); ++k) {
+    for (const auto& [x, y] :
+         {std::pair{rulings[k].a, rulings[k + 1].a}, std::pair{rulings[k].b, rulings[k + 1].b}}) {
+      if (x == y) continue;
+      const std::vector<int> p1 = path(x, y);
+      const std::vector<int> p2 = path(y, x);
+      if (std::min(p1.size(), p2.size()) != 2) {
+        return {false, "a strip cell would hold an extra boundary vertex"};
+      }
+    }
+  }
+  // Commit: drop F's faces, add the flat sides and the curved strip.
+  removeRegionFaces(g, region);
+  for (const std::vector<int>& side : sides) {
+    triangulatePolygon(g, side, addRegion(g, mesh::RegionType::Flat), interior);
+  }
+  const int curved = addRegion(g, mesh::RegionType::Curved);
+  g.regions[static_cast<std::size_t>(curved)].rulings = rulings;
+  g.regions[static_cast<std::size_t>(curved)].apex = pencil.apex;
+  rebuildCurvedFaces(g, curved);
+  return {true, {}};
+}
+
+}  // namespace crumple::paper::detail
