@@ -1,0 +1,445 @@
+// ElasticSheet's backward Euler step: Newton on the incremental potential
+// with a backtracking line search, substep halving and the recovery of a
+// step that failed at every halving (the method: elastic_sheet.cpp's header
+// comment; paper Sec. 4, thesis 2.3.1).
+#include "crumple/sim/elastic_sheet.hpp"
+#include "elastic_sheet_impl.hpp"
+
+namespace crumple::sim {
+
+bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, StepStats& stats,
+                                 std::string& why) {
+  const double h = t1 - t0;
+  // Animated colliders: where the step begins, then where it ends.
+  if (collidersOn() && contact.moveColliders) {
+    contact.moveColliders(t0);
+    contact.moveColliders(t1);
+  }
+  // Handle targets at t1 (paper Sec. 4: handles are hard constraints).
+  pinBuffer.clear();
+  if (pins) pins(t1, pinBuffer);
+  pinTarget.assign(vertexCount, -1);
+  std::vector<int> pinned;
+  pinned.reserve(pinBuffer.size());
+  for (std::size_t i = 0; i < pinBuffer.size(); ++i) {
+    const int vtx = pinBuffer[i].vertex;
+    if (vtx < 0 || static_cast<std::size_t>(vtx) >= vertexCount)
+      throw std::out_of_range("ElasticSheet: pin on vertex " + std::to_string(vtx) + " (mesh has " +
+                              std::to_string(vertexCount) + ")");
+    if (!pinBuffer[i].position.allFinite()) {
+      why = "non-finite pin target for vertex " + std::to_string(vtx);
+      return false;
+    }
+    if (pinTarget[static_cast<std::size_t>(vtx)] < 0) pinned.push_back(vtx);
+    pinTarget[static_cast<std::size_t>(vtx)] = static_cast<int>(i);  // the last one wins
+  }
+  std::sort(pinned.begin(), pinned.end());
+  if ((!systemBuilt || pinned != pinnedSet) && !buildSystem(pinned)) {
+    why = "symbolic Cholesky analysis failed";
+    return false;
+  }
+
+  const std::size_t nv = vertexCount;
+  const double alpha = params.massDamping;
+  const double beta = params.stiffnessDamping;
+  const std::vector<Vec3>& xn = x;
+  const std::vector<Vec3>& vn = v;
+  std::vector<Vec3> xTilde(nv), xk(nv), xTrial(nv);
+  for (std::size_t i = 0; i < nv; ++i) {
+    xTilde[i] = xn[i] + h * vn[i] + (h * h) * params.gravity;
+    if (pinTarget[i] >= 0)
+      xk[i] = pinBuffer[static_cast<std::size_t>(pinTarget[i])].position;
+    else if (freeIndex[i] >= 0)
+      xk[i] = xn[i] + h * vn[i];  // predictor
+    else
+      xk[i] = xn[i];  // a vertex in no triangle stays put
+  }
+
+  const int n = 3 * freeCount;
+
+  // Rayleigh stiffness damping: projected element stiffness frozen at x_n.
+  const double dampScale = beta / h;
+  if (beta > 0.0) {
+    evaluate(xn, true, true);
+    triDamp = triHess;
+    hingeDamp = hingeHess;
+  }
+  auto dampProduct = [&](const std::vector<Vec3>& u, VecX& out) {  // out += beta/h K^_n u
+    scatterProducts(triangles, triDamp, u, freeIndex, dampScale, out);
+    scatterProducts(hingeVertices, hingeDamp, u, freeIndex, dampScale, out);
+  };
+
+  const double massDiag = 1.0 / (h * h) + alpha / h;
+
+  findContacts(xn, xk, h, stats);
+  // Coulomb friction with the lagged normal force (IPC's smoothed friction
+  // potential, Li et al. 2020, Sec. 5): the tangential displacement over the
+  // step u = T (x - x_n) costs mu lambda f0(|u|), where f0 is |u| beyond
+  // eps = kFrictionSpeed h and a cubic below it (static friction as a stiff,
+  // capped spring). frictionTerms gives the energy, and the gradient and
+  // (PSD) Hessian block of one contact.
+  const double eps = kFrictionSpeed * h;
+  auto frictionTerms = [&](const ContactPlane& cp, const Vec3& xi, const Vec3& xni, Vec3* grad,
+                           Mat3* hess) {
+    if (!(cp.mu > 0.0) || !(cp.lambda > 0.0)) return 0.0;
+    const Mat3 t = Mat3::Identity() - cp.normal * cp.normal.transpose();
+    const Vec3 u = t * ((xi - xni) - cp.motion);
+    const double y = u.norm();
+    const double scale = cp.mu * cp.lambda;
+    const double f0 = y >= eps ? y : -y * y * y / (3.0 * eps * eps) + y * y / eps + eps / 3.0;
+    if (grad != nullptr) {
+      const double f1OverY = y >= eps ? 1.0 / y : -y / (eps * eps) + 2.0 / eps;
+      const double f1Prime = y >= eps ? 0.0 : -2.0 * y / (eps * eps) + 2.0 / eps;
+      *grad = scale * f1OverY * u;
+      if (hess != nullptr) {
+        Mat3 inner = f1OverY * Mat3::Identity();
+        if (y > 1e-300) {
+          const Vec3 d = u / y;
+          inner += (f1Prime - f1OverY) * d * d.transpose();
+        }
+        *hess = scale * t * inner * t;
+      }
+    }
+    return scale * f0;
+  };
+  // Penalty and friction energy of the contacts at xs.
+  auto contactEnergy = [&](const std::vector<Vec3>& xs) {
+    double e = 0.0;
+    for (const auto& cp : contactPlanes) {
+      const auto vi = static_cast<std::size_t>(cp.vertex);
+      const double gap = cp.gap(xs[vi], contact.distance, nullptr);
+      if (gap > 0.0) e += 0.5 * cp.k * gap * gap;
+      e += frictionTerms(cp, xs[vi], xn[vi], nullptr, nullptr);
+    }
+    for (const auto& fc : faceContacts) {
+      const double gap =
+          fc.gap(xs, triangles[static_cast<std::size_t>(fc.triangle)], contact.distance);
+      if (gap > 0.0) e += 0.5 * fc.k * gap * gap;
+    }
+    return e;
+  };
+  static const bool debugNewton = [] {
+    const char* e = std::getenv("CRUMPLE_DEBUG_NEWTON");
+    return e != nullptr && e[0] == '1';
+  }();
+  const double tol = params.newtonTolerance * typicalEdge;
+  VecX gradQ(n), gradV(n), grad(n), dx(n);
+  std::vector<Vec3> disp(nv);
+  // Nothing to solve when every vertex is pinned: the step is the pins.
+  bool converged = n == 0;
+  for (int it = 0; !converged && it < params.maxNewtonIterations; ++it) {
+    // Exact element Hessians first (quadratic convergence); projected to PSD
+    // only if the assembled system turns out not to be positive definite.
+    evaluate(xk, true, false);
+    ++stats.newtonIterations;
+
+    // Gradient over the free DOFs: quadratic (inertia, gravity, damping) + elastic.
+    gradQ.setZero();
+    gradV.setZero();
+    for (std::size_t i = 0; i < nv; ++i) {
+      const int fi = freeIndex[i];
+      if (fi < 0) continue;
+      gradQ.segment<3>(3 * fi) =
+          mass[i] * ((xk[i] - xTilde[i]) / (h * h) + (alpha / h) * (xk[i] - xn[i]));
+    }
+    if (beta > 0.0) {
+      for (std::size_t i = 0; i < nv; ++i) disp[i] = xk[i] - xn[i];
+      dampProduct(disp, gradQ);
+    }
+    scatterVectors(triangles, triGrad, freeIndex, 1.0, gradV);
+    scatterVectors(hingeVertices, hingeGrad, freeIndex, 1.0, gradV);
+    for (const auto& cp : contactPlanes) {
+      const auto vi = static_cast<std::size_t>(cp.vertex);
+      Vec3 n;
+      const double gap = cp.gap(xk[vi], contact.distance, &n);
+      if (gap > 0.0) gradV.segment<3>(3 * freeIndex[vi]) -= cp.k * gap * n;
+      Vec3 g = Vec3::Zero();
+      frictionTerms(cp, xk[vi], xn[vi], &g, nullptr);
+      gradV.segment<3>(3 * freeIndex[vi]) += g;
+    }
+    for (const auto& fc : faceContacts) {
+      const auto& tri = triangles[static_cast<std::size_t>(fc.triangle)];
+      const double gap = fc.gap(xk, tri, contact.distance);
+      if (!(gap > 0.0)) continue;
+      for (std::size_t a = 0; a < 3; ++a) {
+        const int fi = freeIndex[static_cast<std::size_t>(tri[a])];
+        if (fi >= 0) gradV.segment<3>(3 * fi) -= fc.k * gap * fc.w[a] * fc.normal;
+      }
+    }
+    grad = gradQ + gradV;
+    if (!grad.allFinite()) {
+      why = "non-finite forces";
+      return false;
+    }
+
+    // Hessian: lumped mass / damping diagonal + element blocks, serially in
+    // element order (bit-identical for any thread count).
+    auto assemble = [&]() {
+      double* values = matrix.valuePtr();
+      std::fill(values, values + matrix.nonZeros(), 0.0);
+      for (std::size_t i = 0; i < nv; ++i) {
+        const int fi = freeIndex[i];
+        if (fi < 0) continue;
+        for (int c = 0; c < 3; ++c)
+          values[diagOffset[static_cast<std::size_t>(3 * fi + c)]] += mass[i] * massDiag;
+      }
+      scatterBlocks(triHess, beta > 0.0 ? &triDamp : nullptr, dampScale, triOffset, values);
+      scatterBlocks(hingeHess, beta > 0.0 ? &hingeDamp : nullptr, dampScale, hingeOffset, values);
+      for (const auto& cp : contactPlanes) {
+        const auto vi = static_cast<std::size_t>(cp.vertex);
+        Mat3 block = Mat3::Zero();
+        // Gauss-Newton for a triangle's distance: the curvature term of
+        // |x - q| is left out (it would make the block indefinite).
+        Vec3 n;
+        if (cp.gap(xk[vi], contact.distance, &n) > 0.0) block += cp.k * n * n.transpose();
+        Vec3 g;
+        Mat3 hf = Mat3::Zero();
+        frictionTerms(cp, xk[vi], xn[vi], &g, &hf);
+        block += hf;
+        const int* off = vertexOffset.data() + 9 * freeIndex[vi];
+        for (int col = 0; col < 3; ++col)
+          for (int row = col; row < 3; ++row) values[off[col * 3 + row]] += block(row, col);
+      }
+      for (const auto& fc : faceContacts) {
+        const auto& tri = triangles[static_cast<std::size_t>(fc.triangle)];
+        if (!(fc.gap(xk, tri, contact.distance) > 0.0)) continue;
+        Vec9 g;
+        for (int a = 0; a < 3; ++a)
+          g.segment<3>(3 * a) = fc.w[static_cast<std::size_t>(a)] * fc.normal;
+        const Mat9 block = fc.k * g * g.transpose();
+        const int* off = triOffset.data() + 81 * fc.triangle;
+        for (int i = 0; i < 81; ++i)
+          if (off[i] >= 0) values[off[i]] += block.data()[i];
+      }
+      return Eigen::Map<const VecX>(values, matrix.nonZeros()).allFinite();
+    };
+    if (!assemble()) {
+      why = "non-finite stiffness matrix";
+      return false;
+    }
+    solver.factorize(matrix);
+    ++stats.solves;
+    bool projected = false;
+    if (solver.info() != Eigen::Success) {
+      projected = true;
+      // Indefinite (compressed membrane, bent hinges): project every element
+      // block to PSD; with the positive mass term the system is then SPD.
+      projectHessians();
+      if (!assemble()) {
+        why = "non-finite stiffness matrix";
+        return false;
+      }
+      solver.factorize(matrix);
+      ++stats.solves;
+      if (solver.info() != Eigen::Success) {
+        why = "Cholesky factorisation failed";
+        return false;
+      }
+    }
+    dx = solver.solve(-grad);
+    if (solver.info() != Eigen::Success || !dx.allFinite()) {
+      why = "Cholesky solve failed";
+      return false;
+    }
+    const double stepNorm = dx.lpNorm<Eigen::Infinity>();
+    stats.finalStepNorm = stepNorm;
+
+    auto applyStep = [&](double s) {
+      xTrial = xk;
+      for (std::size_t i = 0; i < nv; ++i) {
+        const int fi = freeIndex[i];
+        if (fi >= 0) xTrial[i] = xk[i] + s * dx.segment<3>(3 * fi);
+      }
+    };
+    if (stepNorm <= tol) {
+      applyStep(1.0);
+      xk.swap(xTrial);
+      converged = true;
+      break;
+    }
+
+    // Backtracking line search on Phi (Armijo).
+    const double slope = grad.dot(dx);
+    if (!(slope < 0.0)) {
+      why = "Newton direction is not a descent direction";
+      return false;
+    }
+    // Exact change of the quadratic part: s gradQ.dx + s^2/2 dx^T Q dx.
+    double curvature = 0.0;
+    for (std::size_t i = 0; i < nv; ++i) {
+      const int fi = freeIndex[i];
+      if (fi >= 0) curvature += mass[i] * massDiag * dx.segment<3>(3 * fi).squaredNorm();
+    }
+    if (beta > 0.0) {
+      for (std::size_t i = 0; i < nv; ++i) {
+        const int fi = freeIndex[i];
+        disp[i] = fi >= 0 ? Vec3(dx.segment<3>(3 * fi)) : Vec3::Zero();
+      }
+      VecX kd = VecX::Zero(n);
+      dampProduct(disp, kd);
+      curvature += kd.dot(dx);
+    }
+    const double slopeQ = gradQ.dot(dx);
+    const double contactNow = contactEnergy(xk);
+    double s = 1.0;
+    bool accepted = false;
+    for (int ls = 0; ls <= kMaxLineSearchHalvings; ++ls, s *= 0.5) {
+      applyStep(s);
+      evaluateEnergies(xTrial);
+      double deltaV = 0.0;
+      for (std::size_t i = 0; i < triangles.size(); ++i) deltaV += triTrial[i] - triEnergy[i];
+      for (std::size_t k = 0; k < hinges.size(); ++k) deltaV += hingeTrial[k] - hingeEnergy[k];
+      if (!contactPlanes.empty() || !faceContacts.empty())
+        deltaV += contactEnergy(xTrial) - contactNow;
+      const double deltaPhi = s * slopeQ + 0.5 * s * s * curvature + deltaV;
+      if (std::isfinite(deltaPhi) && deltaPhi <= kArmijo * s * slope) {
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) {
+      // Within a hundred tolerances of the solution the energy decrease of
+      // the Newton step is below Phi's rounding: the iterate is as converged
+      // as the arithmetic allows.
+      if (stepNorm <= 100.0 * tol) {
+        converged = true;
+        break;
+      }
+      why = "line search found no decrease";
+      return false;
+    }
+    if (debugNewton) {
+      std::size_t worst = 0;
+      double wn = -1.0;
+      for (std::size_t i = 0; i < nv; ++i) {
+        const int fi = freeIndex[i];
+        if (fi >= 0 && dx.segment<3>(3 * fi).norm() > wn) {
+          wn = dx.segment<3>(3 * fi).norm();
+          worst = i;
+        }
+      }
+      std::fprintf(
+          stderr, "[newton] h %.3g it %d step %.3e s %.3g worst v %zu mass %.3g (mean %.3g)%s\n", h,
+          it, stepNorm, s, worst, mass[worst], std::accumulate(mass.begin(), mass.end(), 0.0) / nv,
+          projected ? " projected" : "");
+    }
+    xk.swap(xTrial);
+  }
+  if (!converged) {
+    std::ostringstream os;
+    os << "Newton did not converge in " << params.maxNewtonIterations << " iterations (last step "
+       << stats.finalStepNorm << " m)";
+    why = os.str();
+    return false;
+  }
+  if (!finite(xk)) {
+    why = "non-finite positions";
+    return false;
+  }
+  std::vector<Pushed> pushed;
+  lastContacts.clear();
+  if (!contactPlanes.empty() || !faceContacts.empty() || collidersOn())
+    resolveContacts(xn, xk, h, stats, pushed);
+  for (std::size_t i = 0; i < nv; ++i) {
+    v[i] = (xk[i] - xn[i]) / h;
+    x[i] = xk[i];
+  }
+  // A pushed vertex keeps no velocity into the surface it was pushed out of
+  // (relative to that surface's own velocity).
+  for (const Pushed& p : pushed)
+    v[p.vertex] -= std::min(0.0, (v[p.vertex] - p.surfaceVelocity).dot(p.normal)) * p.normal;
+  trackBranches(x);
+  return true;
+}
+
+// Substep halving: a failed step is retried as two halves, recursively. The
+// end times are passed through exactly, so the last substep asks the pins
+// for exactly t + dt.
+bool ElasticSheet::Impl::stepRecursive(double t0, double t1, const PinFunction& pins, int depth,
+                                       StepStats& stats, std::string& why) {
+  if (substep(t0, t1, pins, stats, why)) return true;
+  if (depth >= params.maxHalvings) return false;
+  ++stats.halvings;
+  const double mid = t0 + 0.5 * (t1 - t0);
+  if (!stepRecursive(t0, mid, pins, depth + 1, stats, why)) return false;
+  return stepRecursive(mid, t1, pins, depth + 1, stats, why);
+}
+
+StepStats ElasticSheet::advance(double t, double dt, const PinFunction& pins) {
+  if (!(dt > 0.0) || !std::isfinite(dt) || !std::isfinite(t))
+    throw std::invalid_argument("ElasticSheet::advance: need finite t and dt > 0");
+  StepStats stats;
+  const std::vector<Vec3> x0 = impl_->x, v0 = impl_->v;
+  std::string why;
+  bool ok = false;
+  try {
+    ok = impl_->stepRecursive(t, t + dt, pins, 0, stats, why);
+  } catch (...) {
+    impl_->x = x0;
+    impl_->v = v0;
+    throw;
+  }
+  // Recovery (issue 9, stability), only for a step that failed at every
+  // halving (a path the samples never take). If self-contact ran, the step
+  // is taken again without it: its penalty can keep a handle jumping through
+  // the sheet or a tight twist from converging. Then, as the projected Newton
+  // iteration converges only linearly near tight folds, with
+  // kRetryIterationFactor times the iterations (and up to 3 halvings), with
+  // self-contact and, if it ran, without. Only then does the shot stop.
+  const auto retry = [&](int maxIterations, SelfContactMode self, int depth, const char* what) {
+    impl_->x = x0;
+    impl_->v = v0;
+    const int savedIterations = impl_->params.maxNewtonIterations;
+    const SelfContactMode savedSelf = impl_->contact.self;
+    impl_->params.maxNewtonIterations = maxIterations;
+    impl_->contact.self = self;
+    StepStats more;
+    std::string moreWhy;
+    bool done = false;
+    try {
+      done = impl_->stepRecursive(t, t + dt, pins, depth, more, moreWhy);
+    } catch (...) {
+      impl_->params.maxNewtonIterations = savedIterations;
+      impl_->contact.self = savedSelf;
+      impl_->x = x0;
+      impl_->v = v0;
+      throw;
+    }
+    impl_->params.maxNewtonIterations = savedIterations;
+    impl_->contact.self = savedSelf;
+    stats.newtonIterations += more.newtonIterations;
+    stats.halvings += more.halvings;
+    stats.solves += more.solves;
+    stats.finalStepNorm = more.finalStepNorm;
+    stats.contactMs += more.contactMs;
+    stats.selfContactMs += more.selfContactMs;
+    if (!done) why += std::string("; ") + what + ": " + moreWhy;
+    return done;
+  };
+  const SimParams& p = impl_->params;
+  const bool selfRan = impl_->contact.self != SelfContactMode::Off && stats.selfContactSteps > 0;
+  if (!ok && selfRan && p.recoverFailedSteps) {
+    ok = retry(p.maxNewtonIterations, SelfContactMode::Off, 0, "without self-contact");
+    if (ok) stats.selfContactDropped = 1;
+  }
+  const SelfContactMode modes[] = {impl_->contact.self, SelfContactMode::Off};
+  for (int k = 0; k < (selfRan ? 2 : 1) && !ok && p.recoverFailedSteps; ++k) {
+    ok = retry(kRetryIterationFactor * p.maxNewtonIterations, modes[k],
+               std::max(0, p.maxHalvings - 3),
+               k == 1 ? "with more Newton iterations, without self-contact"
+                      : "with more Newton iterations");
+    if (ok) stats.newtonRetried = 1;
+    if (ok && k == 1) stats.selfContactDropped = 1;
+  }
+  if (!ok) {
+    impl_->x = x0;
+    impl_->v = v0;
+    std::ostringstream os;
+    os << "step from t = " << t << " s by " << dt << " s failed after " << stats.halvings
+       << " halvings (maxHalvings " << impl_->params.maxHalvings << "): " << why;
+    throw NumericalError("elastic", os.str());
+  }
+  return stats;
+}
+
+}  // namespace crumple::sim

@@ -1,0 +1,299 @@
+#pragma once
+// Internal to src/sim (not installed): ElasticSheet's state and the helpers
+// its parts share (elastic_sheet.cpp: set-up and element terms;
+// elastic_newton.cpp: the backward Euler step; elastic_contacts.cpp: the
+// contacts; docs/ARCHITECTURE.md).
+#include <dlfcn.h>
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <mutex>
+#include <numbers>
+#include <numeric>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "crumple/core/error.hpp"
+#include "crumple/core/parallel.hpp"
+#include "crumple/sim/colliders.hpp"
+#include "crumple/sim/elastic_sheet.hpp"
+#include "crumple/sim/energies.hpp"
+#include "crumple/sim/self_contact.hpp"
+
+namespace crumple::sim {
+// Internal linkage: each of the three sources gets its own copy.
+namespace {
+
+// Element scatter/gather shared by triangles (N = 3, membrane) and hinges
+// (N = 4, bending). Elements are visited in index order, so sums are
+// bit-identical whatever the thread count that computed the element terms.
+template <std::size_t N>
+using ElementVec = Eigen::Matrix<double, 3 * static_cast<int>(N), 1>;
+template <std::size_t N>
+using ElementMat = Eigen::Matrix<double, 3 * static_cast<int>(N), 3 * static_cast<int>(N)>;
+
+// out(free DOFs) += scale * v_e for every element e.
+template <std::size_t N>
+void scatterVectors(const std::vector<std::array<int, N>>& elements,
+                    const std::vector<ElementVec<N>>& v, const std::vector<int>& freeIndex,
+                    double scale, Eigen::VectorXd& out) {
+  for (std::size_t e = 0; e < elements.size(); ++e)
+    for (std::size_t a = 0; a < N; ++a) {
+      const int fi = freeIndex[static_cast<std::size_t>(elements[e][a])];
+      if (fi >= 0)
+        out.segment<3>(3 * fi) += scale * v[e].template segment<3>(3 * static_cast<int>(a));
+    }
+}
+
+// out(free DOFs) += scale * K_e u_e for every element e (u per vertex).
+template <std::size_t N>
+void scatterProducts(const std::vector<std::array<int, N>>& elements,
+                     const std::vector<ElementMat<N>>& k, const std::vector<Vec3>& u,
+                     const std::vector<int>& freeIndex, double scale, Eigen::VectorXd& out) {
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    ElementVec<N> ue;
+    for (std::size_t a = 0; a < N; ++a)
+      ue.template segment<3>(3 * static_cast<int>(a)) = u[static_cast<std::size_t>(elements[e][a])];
+    const ElementVec<N> f = scale * (k[e] * ue);
+    for (std::size_t a = 0; a < N; ++a) {
+      const int fi = freeIndex[static_cast<std::size_t>(elements[e][a])];
+      if (fi >= 0) out.segment<3>(3 * fi) += f.template segment<3>(3 * static_cast<int>(a));
+    }
+  }
+}
+
+// values[offset] += H_e (+ dampScale * D_e) for every element block entry
+// that lands on a free-DOF pair (offsets: (3N)^2 per element, -1 = pinned).
+template <int M>
+void scatterBlocks(const std::vector<Eigen::Matrix<double, M, M>>& hess,
+                   const std::vector<Eigen::Matrix<double, M, M>>* damp, double dampScale,
+                   const std::vector<int>& offsets, double* values) {
+  for (std::size_t e = 0; e < hess.size(); ++e) {
+    const int* off = offsets.data() + e * M * M;
+    const double* hv = hess[e].data();
+    const double* dv = damp ? (*damp)[e].data() : nullptr;
+    for (int i = 0; i < M * M; ++i)
+      if (off[i] >= 0) values[off[i]] += dv ? hv[i] + dampScale * dv[i] : hv[i];
+  }
+}
+
+using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+using Solver = Eigen::CholmodDecomposition<SpMat, Eigen::Lower>;
+using VecX = Eigen::VectorXd;
+
+// From this many free DOFs on, the supernodal LL^T (dense BLAS kernels on
+// supernodes) beats the simplicial one (bench_sim, one substep, medians:
+// 96 triangles 0.37 vs 0.47 ms, 1 064 triangles 13.8 vs 13.9 ms, 10 080
+// triangles 413 vs 183 ms for simplicial vs supernodal).
+// Contact penalty stiffness in units of the vertex's mass / h^2: the gap
+// left by a force F is F h^2 / (kContactScale m), 1e-6 m for gravity at
+// h = 1/96 s, about 1 % of a sheet's thickness (issue 5).
+constexpr double kContactScale = 1000.0;
+constexpr double kFailsafeSlack = kContactFailsafeSlack;
+// Contacts are looked for within 2 D plus this many times the predicted move
+// of a vertex over the step (plus what gravity adds): other forces (a handle
+// pulling) can make it move farther than predicted.
+constexpr double kReachMoves = 1.5;
+// Below this tangential speed (m/s) friction acts as a stiff spring (static
+// friction, smoothed); above it, as Coulomb's constant force.
+constexpr double kFrictionSpeed = 1e-3;
+
+constexpr int kSupernodalMinDofs = 3000;
+
+// OpenBLAS (Debian's libblas.so.3 with libopenblas0) threads its kernels;
+// pinned to one thread, the supernodal factorisation gives bit-identical
+// results whatever --threads says. No-op under another BLAS.
+inline void pinBlasToOneThread() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    using SetThreads = void (*)(int);
+    if (auto* set = reinterpret_cast<SetThreads>(::dlsym(RTLD_DEFAULT, "openblas_set_num_threads")))
+      set(1);
+  });
+}
+
+constexpr std::size_t kMinChunk = 64;       // elements per parallelFor task
+constexpr double kArmijo = 1e-4;            // sufficient-decrease constant
+constexpr int kMaxLineSearchHalvings = 30;  // alpha down to ~1e-9
+
+inline bool finite(const std::vector<Vec3>& xs) {
+  for (const Vec3& p : xs)
+    if (!p.allFinite()) return false;
+  return true;
+}
+
+}  // namespace
+
+struct ElasticSheet::Impl {
+  // ---- model (fixed topology, rest state from the pattern) ----
+  SimParams params;
+  MembraneModuli moduli;
+  double bendingRigidity = 0.0;  // D (N m)
+  std::size_t vertexCount = 0;
+  std::vector<std::array<int, 3>> triangles;
+  std::vector<TriangleRest> triangleRests;
+  std::vector<mesh::MeshEdge> hinges;
+  std::vector<std::array<int, 4>> hingeVertices;  // (x0, x1, x2, x3) as in dihedralAngle
+  std::vector<double> hingeBase;                  // hingeStiffness(D, 1, ...)
+  std::vector<double> hingeFactor;
+  std::vector<double> hingeRest;
+  // Continuous (unwrapped) dihedral angle of each hinge at the last accepted
+  // state: atan2 wraps at +-pi, which would make a hinge folded past pi
+  // (sheets pass through themselves without contacts) jump to the other
+  // branch and the energy's gradient flip sign; angles are measured on the
+  // branch nearest to this one instead.
+  std::vector<double> hingeBranch;
+  // The branch is followed up to 1.5 pi (a flap folded half a turn through
+  // its neighbour) and re-based beyond: a vertex moved by the caller (the
+  // hybrid model's isometry step) could otherwise wind a hinge by whole turns,
+  // whose bending force then tries to unwind them (crumple: hinges at 15-100
+  // rad, 4 m/s, twice the Newton iterations; docs/CRUMPLING.md).
+  static constexpr double kMaxTrackedHinge = 1.5 * std::numbers::pi;
+  std::vector<double> mass;  // lumped, kg
+  std::vector<char> active;  // vertex belongs to a triangle
+  double typicalEdge = 0.0;  // mean pattern edge length (m)
+
+  // ---- state ----
+  std::vector<Vec3> x, v;
+
+  // ---- per-element scratch (filled in parallel, reduced in element order) ----
+  std::vector<double> triEnergy, hingeEnergy, triTrial, hingeTrial;
+  std::vector<Vec9> triGrad;
+  std::vector<Mat9> triHess, triDamp;
+  std::vector<Vec12> hingeGrad;
+  std::vector<Mat12> hingeHess, hingeDamp;
+
+  // ---- linear system, rebuilt only when the pin set changes ----
+  bool systemBuilt = false;
+  std::vector<int> pinnedSet;  // sorted pinned vertices of the current pattern
+  std::vector<int> freeIndex;  // vertex -> free block index, -1 if pinned/inactive
+  int freeCount = 0;
+  SpMat matrix;                   // lower triangle, 3 x 3 blocks
+  std::vector<int> triOffset;     // 81 per triangle: value index or -1
+  std::vector<int> hingeOffset;   // 144 per hinge
+  std::vector<int> diagOffset;    // per free DOF
+  std::vector<int> vertexOffset;  // 9 per free vertex: its 3x3 diagonal block (lower part), or -1
+
+  // Contacts (issue 5): colliders and self-contact (setContacts).
+  ContactOptions contact;
+  std::vector<Vec2> pattern;                        // material coordinates, for self-contact
+  std::optional<SelfContactDetector> selfDetector;  // built on first use
+  // Per step: the frozen contact planes (a vertex may have several).
+  struct ContactPlane {
+    int vertex;
+    int collider;   // ColliderSet index, -1 = the sheet itself
+    Vec3 point;     // on the touched surface, where it is at the end of the step
+    Vec3 normal;    // unit, out of the touched surface
+    Vec3 motion;    // the touched surface's displacement over the step
+    double mu;      // Coulomb friction coefficient
+    double lambda;  // lagged normal force (N) at the start of the step
+    double k;       // penalty stiffness (N/m)
+    // An edge or corner contact with another layer (SelfContactPair::face
+    // false) keeps the distance to that triangle, frozen where the layer's
+    // velocity carries it, rather than to a plane: a plane through an edge
+    // would stand in the way of vertices that pass the triangle by.
+    bool toTriangle = false;
+    std::array<Vec3, 3> triangle{};
+    // The penalty's gap (contact distance minus the distance) at x, and the
+    // direction it pushes along.
+    double gap(const Vec3& x, double distance, Vec3* direction) const {
+      if (!toTriangle) {
+        if (direction != nullptr) *direction = normal;
+        return distance - normal.dot(x - point);
+      }
+      const Vec3 d = x - closestPointOnTriangle(x, triangle[0], triangle[1], triangle[2]);
+      const double len = d.norm();
+      if (direction != nullptr) *direction = len > 0.0 ? Vec3(d / len) : normal;
+      return distance - len;
+    }
+  };
+  std::vector<ContactPlane> contactPlanes;
+  // A collider probe (a ball's centre, a box's corner) near the inside of a
+  // triangle: the triangle's point w keeps radius + D from it along the
+  // normal frozen at the start of the step (vertex contacts alone let a
+  // ball through a coarse mesh). The penalty acts on the triangle's
+  // vertices through w, in the triangle's own block.
+  struct FaceContact {
+    int triangle;
+    int collider;
+    std::array<double, 3> w;
+    Vec3 probe;  // where the probe ends the step
+    double radius;
+    Vec3 normal;  // unit, from the probe toward the sheet
+    double k;
+    double gap(const std::vector<Vec3>& xs, const std::array<int, 3>& t, double distance) const {
+      Vec3 q = Vec3::Zero();
+      for (std::size_t a = 0; a < 3; ++a) q += w[a] * xs[static_cast<std::size_t>(t[a])];
+      return radius + distance - normal.dot(q - probe);
+    }
+  };
+  std::vector<FaceContact> faceContacts;
+  std::vector<SelfContactPair> selfPairs;  // this step's, for the failsafe
+  std::vector<ContactSample> lastContacts;
+  long contactVertexSteps = 0;  // contacts found, summed over steps (statistics)
+  bool collidersOn() const { return contact.colliders != nullptr && contact.colliders->size() > 0; }
+  // The contact planes of a step from x_n (xn) to the predictor xk.
+  void findContacts(const std::vector<Vec3>& xn, const std::vector<Vec3>& xk, double h,
+                    StepStats& stats);
+  void findFaceContacts(const std::vector<Vec3>& xn, const std::vector<Vec3>& xk, double h,
+                        double fall);
+  // Failsafe projection and the step's contact samples.
+  struct Pushed {
+    std::size_t vertex;
+    Vec3 normal;           // pushed out along
+    Vec3 surfaceVelocity;  // of the surface it was pushed out of
+  };
+  void resolveContacts(const std::vector<Vec3>& xn, std::vector<Vec3>& xk, double h,
+                       StepStats& stats, std::vector<Pushed>& pushed);
+  Solver solver;
+  int analyzeCount = 0;
+  bool supernodal = false;  // which CHOLMOD factorisation the last analysis chose
+
+  // ---- step scratch ----
+  std::vector<Pin> pinBuffer;
+  std::vector<int> pinTarget;  // vertex -> index into pinBuffer, -1 if free
+
+  Impl(const mesh::SheetMesh& m, const Material& material, const SimParams& p);
+  bool buildSystem(const std::vector<int>& pinned);
+  void evaluate(const std::vector<Vec3>& xs, bool derivatives, bool project);
+  void evaluateEnergies(const std::vector<Vec3>& xs);
+  void projectHessians();
+  bool substep(double t0, double t1, const PinFunction& pins, StepStats& stats, std::string& why);
+  bool stepRecursive(double t0, double t1, const PinFunction& pins, int depth, StepStats& stats,
+                     std::string& why);
+  double hingeStiffnessOf(std::size_t k) const { return hingeBase[k] * hingeFactor[k]; }
+  // The raw (wrapped) dihedral angle of hinge k at xs.
+  double rawAngle(std::size_t k, const std::vector<Vec3>& xs) const {
+    const auto& h = hingeVertices[k];
+    return dihedralAngle(xs[static_cast<std::size_t>(h[0])], xs[static_cast<std::size_t>(h[1])],
+                         xs[static_cast<std::size_t>(h[2])], xs[static_cast<std::size_t>(h[3])]);
+  }
+  // A raw angle of hinge k moved onto the branch nearest to hingeBranch[k].
+  double onBranch(std::size_t k, double raw) const {
+    return hingeBranch[k] + std::remainder(raw - hingeBranch[k], 2.0 * std::numbers::pi);
+  }
+  // Hinge k's angle at xs on the branch nearest to hingeBranch[k].
+  double continuousAngle(std::size_t k, const std::vector<Vec3>& xs) const {
+    return onBranch(k, rawAngle(k, xs));
+  }
+  // Deviation of hinge k from its rest angle on that branch, given its raw angle.
+  double deviation(std::size_t k, double raw) const { return onBranch(k, raw) - hingeRest[k]; }
+  // Moves every hinge's branch to its angle at xs (after an accepted step
+  // or a teleport by the caller).
+  void trackBranches(const std::vector<Vec3>& xs) {
+    for (std::size_t k = 0; k < hingeVertices.size(); ++k) {
+      hingeBranch[k] = continuousAngle(k, xs);
+      if (std::abs(hingeBranch[k]) > kMaxTrackedHinge)
+        hingeBranch[k] -= std::copysign(2.0 * std::numbers::pi, hingeBranch[k]);
+    }
+  }
+};
+
+}  // namespace crumple::sim
