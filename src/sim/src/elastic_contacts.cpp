@@ -8,7 +8,7 @@ namespace crumple::sim {
 
 // One backward Euler step from the current state at t0 to t1.
 // On failure returns false with a reason and leaves the state untouched.
-// Contacts (issue 5; paper Sec. 4): a free vertex that may come within the
+// Contacts (paper Sec. 4; docs/CONTACTS.md): a free vertex that may come within the
 // contact distance D of a collider, or of another layer of the sheet, during
 // the step gets that surface's tangent plane (point p, outward normal m) at
 // the start of the step, frozen for the step, and the penalty

@@ -379,7 +379,7 @@ StepStats ElasticSheet::advance(double t, double dt, const PinFunction& pins) {
     impl_->v = v0;
     throw;
   }
-  // Recovery (issue 9, stability), only for a step that failed at every
+  // Recovery (docs/STABILITY.md), only for a step that failed at every
   // halving (a path the samples never take). If self-contact ran, the step
   // is taken again without it: its penalty can keep a handle jumping through
   // the sheet or a tight twist from converging. Then, as the projected Newton

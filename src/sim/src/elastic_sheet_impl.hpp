@@ -94,7 +94,7 @@ using VecX = Eigen::VectorXd;
 // triangles 413 vs 183 ms for simplicial vs supernodal).
 // Contact penalty stiffness in units of the vertex's mass / h^2: the gap
 // left by a force F is F h^2 / (kContactScale m), 1e-6 m for gravity at
-// h = 1/96 s, about 1 % of a sheet's thickness (issue 5).
+// h = 1/96 s, about 1 % of a sheet's thickness (docs/CONTACTS.md).
 constexpr double kContactScale = 1000.0;
 constexpr double kFailsafeSlack = kContactFailsafeSlack;
 // Contacts are looked for within 2 D plus this many times the predicted move
@@ -181,7 +181,7 @@ struct ElasticSheet::Impl {
   std::vector<int> diagOffset;    // per free DOF
   std::vector<int> vertexOffset;  // 9 per free vertex: its 3x3 diagonal block (lower part), or -1
 
-  // Contacts (issue 5): colliders and self-contact (setContacts).
+  // Contacts (docs/CONTACTS.md): colliders and self-contact (setContacts).
   ContactOptions contact;
   std::vector<Vec2> pattern;                        // material coordinates, for self-contact
   std::optional<SelfContactDetector> selfDetector;  // built on first use

@@ -1,5 +1,5 @@
 #pragma once
-// Rigid colliders the sheet must stay outside of (issue 5: tables, props,
+// Rigid colliders the sheet must stay outside of (docs/CONTACTS.md: tables, props,
 // fingers): analytic planes, boxes and spheres, and triangle meshes held as
 // FCL BVH models, each with a pose updated per substep when animated.
 // Proximity queries with a margin (the paper's thickness) are the contact

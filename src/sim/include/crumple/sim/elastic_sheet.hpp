@@ -38,7 +38,7 @@ struct SimParams {
   // sliver triangles whose vertices would weigh ~1e-4 of the others and stall
   // Newton's convergence; the floor adds a negligible mass there.
   double minVertexMassFraction = 0.0;
-  // Recovery of a step that failed at every halving (issue 9, stability;
+  // Recovery of a step that failed at every halving (docs/STABILITY.md;
   // ElasticSheet::advance): taken again without self-contact, then with
   // kRetryIterationFactor times maxNewtonIterations. Off by default; a shot
   // (pipeline::runShot) turns it on.
@@ -62,7 +62,7 @@ struct StepStats {
   double contactMs = 0.0;      // collider detection and failsafe, wall time (timing only)
   double selfContactMs = 0.0;  // self-contact gate, detection and failsafe (timing only)
   int selfContactSteps = 0;    // (sub)steps in which self-contact detection ran
-  // Recovery of a step that failed even after halving (issue 9, stability):
+  // Recovery of a step that failed even after halving (docs/STABILITY.md):
   // taken again with kRetryIterationFactor times the Newton iterations, or
   // else without self-contact (the sheet may pass through itself there).
   int newtonRetried = 0;
@@ -75,11 +75,11 @@ inline constexpr int kRetryIterationFactor = 10;
 // is left alone: its gap carries the normal force that friction needs).
 inline constexpr double kContactFailsafeSlack = 0.05;
 
-// Self-contact of the sheet (issue 5): never, at every step, or only while
+// Self-contact of the sheet (docs/CONTACTS.md): never, at every step, or only while
 // the sheet is folded (sheetIsFolded with ContactOptions::foldSpread).
 enum class SelfContactMode { Off, On, Auto };
 
-// Contacts of the elastic step (issue 5; paper Sec. 4).
+// Contacts of the elastic step (paper Sec. 4; docs/CONTACTS.md).
 struct ContactOptions {
   // Colliders the free vertices keep `distance` from (not owned; must
   // outlive the sheet or the next setContacts). Null or empty: none.
@@ -96,7 +96,7 @@ struct ContactOptions {
   double foldSpread = 1.0471975511965976;  // rad (60 deg): the Auto gate
 };
 
-// A vertex touching something at the end of a step (issue 5, item 5: what
+// A vertex touching something at the end of a step (docs/CONTACTS.md: what
 // the sound module hears).
 struct ContactSample {
   int vertex = -1;
@@ -105,7 +105,7 @@ struct ContactSample {
   double normalForce = 0.0;  // N, the contact's penalty force
 };
 
-// Checkpoint and resume (issue 8): a list of contact samples in a state.
+// Checkpoint and resume (docs/CHECKPOINT.md): a list of contact samples in a state.
 // restoreContactSamples throws CorruptDataError for a vertex outside
 // [0, vertexCount).
 void saveContactSamples(StateWriter& out, const std::vector<ContactSample>& samples);
@@ -151,7 +151,7 @@ class ElasticSheet {
   // (stage "elastic") and leaves the state as it was before the call.
   StepStats advance(double t, double dt, const PinFunction& pins);
 
-  // Contacts (issue 5): free vertices keep options.distance from every
+  // Contacts (docs/CONTACTS.md): free vertices keep options.distance from every
   // collider and, with self-contact, from the triangles of other layers of
   // the sheet: a penalty on tangent planes frozen at the start of the step
   // (each layer sees the other where its velocity carries it), Coulomb
@@ -166,7 +166,7 @@ class ElasticSheet {
   // The contacts at the end of the last accepted (sub)step, sorted by
   // (vertex, collider), one per pair (forces summed, the fastest slide).
   const std::vector<ContactSample>& contacts() const;
-  // Checkpoint and resume (issue 8): what the sheet carries from one step to
+  // Checkpoint and resume (docs/CHECKPOINT.md): what the sheet carries from one step to
   // the next (positions, velocities, each hinge's rest angle, stiffness
   // factor and branch, the last step's contacts), written for a sheet built
   // again on the same mesh. restoreState throws CorruptDataError when the

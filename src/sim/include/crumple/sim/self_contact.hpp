@@ -1,5 +1,5 @@
 #pragma once
-// Self-contact of the sheet (issue 5, item 3): vertex-triangle proximity
+// Self-contact of the sheet (docs/CONTACTS.md): vertex-triangle proximity
 // pairs between parts of the sheet that lie on top of each other. FCL's
 // dynamic AABB tree over the triangles (their boxes grown by the reach) is
 // the broad phase; triangle pairs that share a vertex are skipped, and the
@@ -81,7 +81,7 @@ class SelfContactDetector {
   std::unique_ptr<Impl> impl_;
 };
 
-// The self-contact gate of `[contact] self = "auto"` (issue 5, item 6): true
+// The self-contact gate of `[contact] self = "auto"` (docs/CONTACTS.md): true
 // when the triangles' unit normals spread more than `maxSpread` (rad) from
 // their area-weighted mean, i.e. the sheet is folded enough for one part to
 // reach another. A sheet that could reach itself without folding (a helical
