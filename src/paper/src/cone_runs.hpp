@@ -3,6 +3,7 @@
 // region refitted as generalized cones (paper Sec. 6.2 last paragraphs,
 // Fig. 15; thesis 2.5.2, Fig. 2.19), used by refitCurvedRegion.
 #include <array>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>

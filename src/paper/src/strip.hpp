@@ -22,6 +22,9 @@ struct Pencil {
   Vec2 dir = Vec2::UnitX();  // direction of chord 0
 };
 
+// Where the walk from the compressed triangle meets F's border (Appendix A,
+// Fig. 6 b-d): dS (free), another flat region, a curved region, or nothing
+// usable; the loop edge crossed and the point.
 struct Border {
   enum class Kind { Free, FlatFlat, Curved, None } kind = Kind::None;
   int loopEdge = -1;
@@ -33,6 +36,7 @@ struct Border {
 Border findBorder(const GeometricMesh& g, const Loop& loop, const Vec2& origin, const Vec2& dir,
                   double tol);
 
+// Whether F was remeshed; else why not (for the developer trace).
 struct StripResult {
   bool done = false;
   std::string note;
