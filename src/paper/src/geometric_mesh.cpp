@@ -10,8 +10,6 @@
 
 namespace crumple::paper {
 
-namespace {}  // namespace
-
 std::vector<GeometricEdge> buildEdges(const GeometricMesh& g) {
   // Half-edges sorted by (min, max) vertex pair, then by face: one
   // allocation, the same order as a map would give.

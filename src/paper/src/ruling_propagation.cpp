@@ -226,8 +226,6 @@ void treatCurvedCompression(GeometricMesh& g, const CrumpleParams& params, const
   compact(g);
 }
 
-namespace {}  // namespace
-
 // A flat region of S_G whose triangles stopped being coplanar (an interior
 // edge above theta_0) is bent, not creased: S_P samples flat regions as a
 // whole, so it bends smoothly across S_G's internal edges. Before the region
