@@ -7,14 +7,7 @@
 
 namespace crumple::sim {
 
-bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, StepStats& stats,
-                                 std::string& why) {
-  const double h = t1 - t0;
-  // Animated colliders: where the step begins, then where it ends.
-  if (collidersOn() && contact.moveColliders) {
-    contact.moveColliders(t0);
-    contact.moveColliders(t1);
-  }
+bool ElasticSheet::Impl::collectPins(double t1, const PinFunction& pins, std::string& why) {
   // Handle targets at t1 (paper Sec. 4: handles are hard constraints).
   pinBuffer.clear();
   if (pins) pins(t1, pinBuffer);
@@ -38,292 +31,351 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
     why = "symbolic Cholesky analysis failed";
     return false;
   }
+  return true;
+}
 
+void ElasticSheet::Impl::startNewton(NewtonState& s) {
+  const double h = s.h;
   const std::size_t nv = vertexCount;
-  const double alpha = params.massDamping;
-  const double beta = params.stiffnessDamping;
-  const std::vector<Vec3>& xn = x;
-  const std::vector<Vec3>& vn = v;
-  std::vector<Vec3> xTilde(nv), xk(nv), xTrial(nv);
+  s.massDiag = 1.0 / (h * h) + params.massDamping / h;
+  s.dampScale = params.stiffnessDamping / h;
+  s.frictionEps = kFrictionSpeed * h;
+  s.xTilde.resize(nv);
+  s.xk.resize(nv);
+  s.xTrial.resize(nv);
+  s.disp.resize(nv);
   for (std::size_t i = 0; i < nv; ++i) {
-    xTilde[i] = xn[i] + h * vn[i] + (h * h) * params.gravity;
+    s.xTilde[i] = x[i] + h * v[i] + (h * h) * params.gravity;
     if (pinTarget[i] >= 0)
-      xk[i] = pinBuffer[static_cast<std::size_t>(pinTarget[i])].position;
+      s.xk[i] = pinBuffer[static_cast<std::size_t>(pinTarget[i])].position;
     else if (freeIndex[i] >= 0)
-      xk[i] = xn[i] + h * vn[i];  // predictor
+      s.xk[i] = x[i] + h * v[i];  // predictor
     else
-      xk[i] = xn[i];  // a vertex in no triangle stays put
+      s.xk[i] = x[i];  // a vertex in no triangle stays put
   }
-
   const int n = 3 * freeCount;
-
+  s.gradQ.resize(n);
+  s.gradV.resize(n);
+  s.grad.resize(n);
+  s.dx.resize(n);
   // Rayleigh stiffness damping: projected element stiffness frozen at x_n.
-  const double dampScale = beta / h;
-  if (beta > 0.0) {
-    evaluate(xn, true, true);
+  if (params.stiffnessDamping > 0.0) {
+    evaluate(x, true, true);
     triDamp = triHess;
     hingeDamp = hingeHess;
   }
-  auto dampProduct = [&](const std::vector<Vec3>& u, VecX& out) {  // out += beta/h K^_n u
-    scatterProducts(triangles, triDamp, u, freeIndex, dampScale, out);
-    scatterProducts(hingeVertices, hingeDamp, u, freeIndex, dampScale, out);
-  };
+}
 
-  const double massDiag = 1.0 / (h * h) + alpha / h;
+void ElasticSheet::Impl::dampProduct(const std::vector<Vec3>& u, double dampScale,
+                                     VecX& out) const {
+  scatterProducts(triangles, triDamp, u, freeIndex, dampScale, out);
+  scatterProducts(hingeVertices, hingeDamp, u, freeIndex, dampScale, out);
+}
 
-  findContacts(xn, xk, h, stats);
-  // Coulomb friction with the lagged normal force (IPC's smoothed friction
-  // potential, Li et al. 2020, Sec. 5): the tangential displacement over the
-  // step u = T (x - x_n) costs mu lambda f0(|u|), where f0 is |u| beyond
-  // eps = kFrictionSpeed h and a cubic below it (static friction as a stiff,
-  // capped spring). frictionTerms gives the energy, and the gradient and
-  // (PSD) Hessian block of one contact.
-  const double eps = kFrictionSpeed * h;
-  auto frictionTerms = [&](const ContactPlane& cp, const Vec3& xi, const Vec3& xni, Vec3* grad,
-                           Mat3* hess) {
-    if (!(cp.mu > 0.0) || !(cp.lambda > 0.0)) return 0.0;
-    const Mat3 t = Mat3::Identity() - cp.normal * cp.normal.transpose();
-    const Vec3 u = t * ((xi - xni) - cp.motion);
-    const double y = u.norm();
-    const double scale = cp.mu * cp.lambda;
-    const double f0 = y >= eps ? y : -y * y * y / (3.0 * eps * eps) + y * y / eps + eps / 3.0;
-    if (grad != nullptr) {
-      const double f1OverY = y >= eps ? 1.0 / y : -y / (eps * eps) + 2.0 / eps;
-      const double f1Prime = y >= eps ? 0.0 : -2.0 * y / (eps * eps) + 2.0 / eps;
-      *grad = scale * f1OverY * u;
-      if (hess != nullptr) {
-        Mat3 inner = f1OverY * Mat3::Identity();
-        if (y > 1e-300) {
-          const Vec3 d = u / y;
-          inner += (f1Prime - f1OverY) * d * d.transpose();
-        }
-        *hess = scale * t * inner * t;
+// The tangential displacement over the step u = T (x - x_n) costs
+// mu lambda f0(|u|), where f0 is |u| beyond eps and a cubic below it (static
+// friction as a stiff, capped spring).
+double ElasticSheet::Impl::frictionTerms(const ContactPlane& cp, const Vec3& xi, const Vec3& xni,
+                                         double eps, Vec3* grad, Mat3* hess) {
+  if (!(cp.mu > 0.0) || !(cp.lambda > 0.0)) return 0.0;
+  const Mat3 t = Mat3::Identity() - cp.normal * cp.normal.transpose();
+  const Vec3 u = t * ((xi - xni) - cp.motion);
+  const double y = u.norm();
+  const double scale = cp.mu * cp.lambda;
+  const double f0 = y >= eps ? y : -y * y * y / (3.0 * eps * eps) + y * y / eps + eps / 3.0;
+  if (grad != nullptr) {
+    const double f1OverY = y >= eps ? 1.0 / y : -y / (eps * eps) + 2.0 / eps;
+    const double f1Prime = y >= eps ? 0.0 : -2.0 * y / (eps * eps) + 2.0 / eps;
+    *grad = scale * f1OverY * u;
+    if (hess != nullptr) {
+      Mat3 inner = f1OverY * Mat3::Identity();
+      if (y > 1e-300) {
+        const Vec3 d = u / y;
+        inner += (f1Prime - f1OverY) * d * d.transpose();
       }
+      *hess = scale * t * inner * t;
     }
-    return scale * f0;
-  };
-  // Penalty and friction energy of the contacts at xs.
-  auto contactEnergy = [&](const std::vector<Vec3>& xs) {
-    double e = 0.0;
-    for (const auto& cp : contactPlanes) {
-      const auto vi = static_cast<std::size_t>(cp.vertex);
-      const double gap = cp.gap(xs[vi], contact.distance, nullptr);
-      if (gap > 0.0) e += 0.5 * cp.k * gap * gap;
-      e += frictionTerms(cp, xs[vi], xn[vi], nullptr, nullptr);
-    }
-    for (const auto& fc : faceContacts) {
-      const double gap =
-          fc.gap(xs, triangles[static_cast<std::size_t>(fc.triangle)], contact.distance);
-      if (gap > 0.0) e += 0.5 * fc.k * gap * gap;
-    }
-    return e;
-  };
-  static const bool debugNewton = [] {
-    const char* e = std::getenv("CRUMPLE_DEBUG_NEWTON");
-    return e != nullptr && e[0] == '1';
-  }();
-  const double tol = params.newtonTolerance * typicalEdge;
-  VecX gradQ(n), gradV(n), grad(n), dx(n);
-  std::vector<Vec3> disp(nv);
-  // Nothing to solve when every vertex is pinned: the step is the pins.
-  bool converged = n == 0;
-  for (int it = 0; !converged && it < params.maxNewtonIterations; ++it) {
-    // Exact element Hessians first (quadratic convergence); projected to PSD
-    // only if the assembled system turns out not to be positive definite.
-    evaluate(xk, true, false);
-    ++stats.newtonIterations;
+  }
+  return scale * f0;
+}
 
-    // Gradient over the free DOFs: quadratic (inertia, gravity, damping) + elastic.
-    gradQ.setZero();
-    gradV.setZero();
-    for (std::size_t i = 0; i < nv; ++i) {
-      const int fi = freeIndex[i];
-      if (fi < 0) continue;
-      gradQ.segment<3>(3 * fi) =
-          mass[i] * ((xk[i] - xTilde[i]) / (h * h) + (alpha / h) * (xk[i] - xn[i]));
-    }
-    if (beta > 0.0) {
-      for (std::size_t i = 0; i < nv; ++i) disp[i] = xk[i] - xn[i];
-      dampProduct(disp, gradQ);
-    }
-    scatterVectors(triangles, triGrad, freeIndex, 1.0, gradV);
-    scatterVectors(hingeVertices, hingeGrad, freeIndex, 1.0, gradV);
-    for (const auto& cp : contactPlanes) {
-      const auto vi = static_cast<std::size_t>(cp.vertex);
-      Vec3 n;
-      const double gap = cp.gap(xk[vi], contact.distance, &n);
-      if (gap > 0.0) gradV.segment<3>(3 * freeIndex[vi]) -= cp.k * gap * n;
-      Vec3 g = Vec3::Zero();
-      frictionTerms(cp, xk[vi], xn[vi], &g, nullptr);
-      gradV.segment<3>(3 * freeIndex[vi]) += g;
-    }
-    for (const auto& fc : faceContacts) {
-      const auto& tri = triangles[static_cast<std::size_t>(fc.triangle)];
-      const double gap = fc.gap(xk, tri, contact.distance);
-      if (!(gap > 0.0)) continue;
-      for (std::size_t a = 0; a < 3; ++a) {
-        const int fi = freeIndex[static_cast<std::size_t>(tri[a])];
-        if (fi >= 0) gradV.segment<3>(3 * fi) -= fc.k * gap * fc.w[a] * fc.normal;
-      }
-    }
-    grad = gradQ + gradV;
-    if (!grad.allFinite()) {
-      why = "non-finite forces";
-      return false;
-    }
+double ElasticSheet::Impl::contactEnergy(const std::vector<Vec3>& xs, double eps) const {
+  double e = 0.0;
+  for (const auto& cp : contactPlanes) {
+    const auto vi = static_cast<std::size_t>(cp.vertex);
+    const double gap = cp.gap(xs[vi], contact.distance, nullptr);
+    if (gap > 0.0) e += 0.5 * cp.k * gap * gap;
+    e += frictionTerms(cp, xs[vi], x[vi], eps, nullptr, nullptr);
+  }
+  for (const auto& fc : faceContacts) {
+    const double gap =
+        fc.gap(xs, triangles[static_cast<std::size_t>(fc.triangle)], contact.distance);
+    if (gap > 0.0) e += 0.5 * fc.k * gap * gap;
+  }
+  return e;
+}
 
-    // Hessian: lumped mass / damping diagonal + element blocks, serially in
-    // element order (bit-identical for any thread count).
-    auto assemble = [&]() {
-      double* values = matrix.valuePtr();
-      std::fill(values, values + matrix.nonZeros(), 0.0);
-      for (std::size_t i = 0; i < nv; ++i) {
-        const int fi = freeIndex[i];
-        if (fi < 0) continue;
-        for (int c = 0; c < 3; ++c)
-          values[diagOffset[static_cast<std::size_t>(3 * fi + c)]] += mass[i] * massDiag;
-      }
-      scatterBlocks(triHess, beta > 0.0 ? &triDamp : nullptr, dampScale, triOffset, values);
-      scatterBlocks(hingeHess, beta > 0.0 ? &hingeDamp : nullptr, dampScale, hingeOffset, values);
-      for (const auto& cp : contactPlanes) {
-        const auto vi = static_cast<std::size_t>(cp.vertex);
-        Mat3 block = Mat3::Zero();
-        // Gauss-Newton for a triangle's distance: the curvature term of
-        // |x - q| is left out (it would make the block indefinite).
-        Vec3 n;
-        if (cp.gap(xk[vi], contact.distance, &n) > 0.0) block += cp.k * n * n.transpose();
-        Vec3 g;
-        Mat3 hf = Mat3::Zero();
-        frictionTerms(cp, xk[vi], xn[vi], &g, &hf);
-        block += hf;
-        const int* off = vertexOffset.data() + 9 * freeIndex[vi];
-        for (int col = 0; col < 3; ++col)
-          for (int row = col; row < 3; ++row) values[off[col * 3 + row]] += block(row, col);
-      }
-      for (const auto& fc : faceContacts) {
-        const auto& tri = triangles[static_cast<std::size_t>(fc.triangle)];
-        if (!(fc.gap(xk, tri, contact.distance) > 0.0)) continue;
-        Vec9 g;
-        for (int a = 0; a < 3; ++a)
-          g.segment<3>(3 * a) = fc.w[static_cast<std::size_t>(a)] * fc.normal;
-        const Mat9 block = fc.k * g * g.transpose();
-        const int* off = triOffset.data() + 81 * fc.triangle;
-        for (int i = 0; i < 81; ++i)
-          if (off[i] >= 0) values[off[i]] += block.data()[i];
-      }
-      return Eigen::Map<const VecX>(values, matrix.nonZeros()).allFinite();
-    };
-    if (!assemble()) {
+bool ElasticSheet::Impl::newtonGradient(NewtonState& s, std::string& why) {
+  // Gradient over the free DOFs: quadratic (inertia, gravity, damping) + elastic.
+  const std::size_t nv = vertexCount;
+  const double h = s.h;
+  const double alpha = params.massDamping;
+  const std::vector<Vec3>& xk = s.xk;
+  s.gradQ.setZero();
+  s.gradV.setZero();
+  for (std::size_t i = 0; i < nv; ++i) {
+    const int fi = freeIndex[i];
+    if (fi < 0) continue;
+    s.gradQ.segment<3>(3 * fi) =
+        mass[i] * ((xk[i] - s.xTilde[i]) / (h * h) + (alpha / h) * (xk[i] - x[i]));
+  }
+  if (params.stiffnessDamping > 0.0) {
+    for (std::size_t i = 0; i < nv; ++i) s.disp[i] = xk[i] - x[i];
+    dampProduct(s.disp, s.dampScale, s.gradQ);
+  }
+  scatterVectors(triangles, triGrad, freeIndex, 1.0, s.gradV);
+  scatterVectors(hingeVertices, hingeGrad, freeIndex, 1.0, s.gradV);
+  for (const auto& cp : contactPlanes) {
+    const auto vi = static_cast<std::size_t>(cp.vertex);
+    Vec3 dir;
+    const double gap = cp.gap(xk[vi], contact.distance, &dir);
+    if (gap > 0.0) s.gradV.segment<3>(3 * freeIndex[vi]) -= cp.k * gap * dir;
+    Vec3 g = Vec3::Zero();
+    frictionTerms(cp, xk[vi], x[vi], s.frictionEps, &g, nullptr);
+    s.gradV.segment<3>(3 * freeIndex[vi]) += g;
+  }
+  for (const auto& fc : faceContacts) {
+    const auto& tri = triangles[static_cast<std::size_t>(fc.triangle)];
+    const double gap = fc.gap(xk, tri, contact.distance);
+    if (!(gap > 0.0)) continue;
+    for (std::size_t a = 0; a < 3; ++a) {
+      const int fi = freeIndex[static_cast<std::size_t>(tri[a])];
+      if (fi >= 0) s.gradV.segment<3>(3 * fi) -= fc.k * gap * fc.w[a] * fc.normal;
+    }
+  }
+  s.grad = s.gradQ + s.gradV;
+  if (!s.grad.allFinite()) {
+    why = "non-finite forces";
+    return false;
+  }
+  return true;
+}
+
+// Hessian: lumped mass / damping diagonal + element blocks, serially in
+// element order (bit-identical for any thread count).
+bool ElasticSheet::Impl::assembleSystem(const NewtonState& s) {
+  const std::vector<Vec3>& xk = s.xk;
+  double* values = matrix.valuePtr();
+  std::fill(values, values + matrix.nonZeros(), 0.0);
+  for (std::size_t i = 0; i < vertexCount; ++i) {
+    const int fi = freeIndex[i];
+    if (fi < 0) continue;
+    for (int c = 0; c < 3; ++c)
+      values[diagOffset[static_cast<std::size_t>(3 * fi + c)]] += mass[i] * s.massDiag;
+  }
+  const bool damped = params.stiffnessDamping > 0.0;
+  scatterBlocks(triHess, damped ? &triDamp : nullptr, s.dampScale, triOffset, values);
+  scatterBlocks(hingeHess, damped ? &hingeDamp : nullptr, s.dampScale, hingeOffset, values);
+  for (const auto& cp : contactPlanes) {
+    const auto vi = static_cast<std::size_t>(cp.vertex);
+    Mat3 block = Mat3::Zero();
+    // Gauss-Newton for a triangle's distance: the curvature term of
+    // |x - q| is left out (it would make the block indefinite).
+    Vec3 dir;
+    if (cp.gap(xk[vi], contact.distance, &dir) > 0.0) block += cp.k * dir * dir.transpose();
+    Vec3 g;
+    Mat3 hf = Mat3::Zero();
+    frictionTerms(cp, xk[vi], x[vi], s.frictionEps, &g, &hf);
+    block += hf;
+    const int* off = vertexOffset.data() + 9 * freeIndex[vi];
+    for (int col = 0; col < 3; ++col)
+      for (int row = col; row < 3; ++row) values[off[col * 3 + row]] += block(row, col);
+  }
+  for (const auto& fc : faceContacts) {
+    const auto& tri = triangles[static_cast<std::size_t>(fc.triangle)];
+    if (!(fc.gap(xk, tri, contact.distance) > 0.0)) continue;
+    Vec9 g;
+    for (int a = 0; a < 3; ++a) g.segment<3>(3 * a) = fc.w[static_cast<std::size_t>(a)] * fc.normal;
+    const Mat9 block = fc.k * g * g.transpose();
+    const int* off = triOffset.data() + 81 * fc.triangle;
+    for (int i = 0; i < 81; ++i)
+      if (off[i] >= 0) values[off[i]] += block.data()[i];
+  }
+  return Eigen::Map<const VecX>(values, matrix.nonZeros()).allFinite();
+}
+
+bool ElasticSheet::Impl::newtonDirection(NewtonState& s, StepStats& stats, bool& projected,
+                                         std::string& why) {
+  if (!assembleSystem(s)) {
+    why = "non-finite stiffness matrix";
+    return false;
+  }
+  solver.factorize(matrix);
+  ++stats.solves;
+  projected = false;
+  if (solver.info() != Eigen::Success) {
+    projected = true;
+    // Indefinite (compressed membrane, bent hinges): project every element
+    // block to PSD; with the positive mass term the system is then SPD.
+    projectHessians();
+    if (!assembleSystem(s)) {
       why = "non-finite stiffness matrix";
       return false;
     }
     solver.factorize(matrix);
     ++stats.solves;
-    bool projected = false;
     if (solver.info() != Eigen::Success) {
-      projected = true;
-      // Indefinite (compressed membrane, bent hinges): project every element
-      // block to PSD; with the positive mass term the system is then SPD.
-      projectHessians();
-      if (!assemble()) {
-        why = "non-finite stiffness matrix";
-        return false;
-      }
-      solver.factorize(matrix);
-      ++stats.solves;
-      if (solver.info() != Eigen::Success) {
-        why = "Cholesky factorisation failed";
-        return false;
-      }
-    }
-    dx = solver.solve(-grad);
-    if (solver.info() != Eigen::Success || !dx.allFinite()) {
-      why = "Cholesky solve failed";
+      why = "Cholesky factorisation failed";
       return false;
     }
-    const double stepNorm = dx.lpNorm<Eigen::Infinity>();
-    stats.finalStepNorm = stepNorm;
+  }
+  s.dx = solver.solve(-s.grad);
+  if (solver.info() != Eigen::Success || !s.dx.allFinite()) {
+    why = "Cholesky solve failed";
+    return false;
+  }
+  return true;
+}
 
-    auto applyStep = [&](double s) {
-      xTrial = xk;
-      for (std::size_t i = 0; i < nv; ++i) {
-        const int fi = freeIndex[i];
-        if (fi >= 0) xTrial[i] = xk[i] + s * dx.segment<3>(3 * fi);
-      }
-    };
+void ElasticSheet::Impl::applyStep(NewtonState& s, double step) const {
+  s.xTrial = s.xk;
+  for (std::size_t i = 0; i < vertexCount; ++i) {
+    const int fi = freeIndex[i];
+    if (fi >= 0) s.xTrial[i] = s.xk[i] + step * s.dx.segment<3>(3 * fi);
+  }
+}
+
+ElasticSheet::Impl::LineSearchResult ElasticSheet::Impl::lineSearch(NewtonState& s, double stepNorm,
+                                                                    double tol, double& step,
+                                                                    std::string& why) {
+  // Backtracking line search on Phi (Armijo).
+  const double slope = s.grad.dot(s.dx);
+  if (!(slope < 0.0)) {
+    why = "Newton direction is not a descent direction";
+    return LineSearchResult::Failed;
+  }
+  // Exact change of the quadratic part: s gradQ.dx + s^2/2 dx^T Q dx.
+  const std::size_t nv = vertexCount;
+  double curvature = 0.0;
+  for (std::size_t i = 0; i < nv; ++i) {
+    const int fi = freeIndex[i];
+    if (fi >= 0) curvature += mass[i] * s.massDiag * s.dx.segment<3>(3 * fi).squaredNorm();
+  }
+  if (params.stiffnessDamping > 0.0) {
+    for (std::size_t i = 0; i < nv; ++i) {
+      const int fi = freeIndex[i];
+      s.disp[i] = fi >= 0 ? Vec3(s.dx.segment<3>(3 * fi)) : Vec3::Zero();
+    }
+    VecX kd = VecX::Zero(3 * freeCount);
+    dampProduct(s.disp, s.dampScale, kd);
+    curvature += kd.dot(s.dx);
+  }
+  const double slopeQ = s.gradQ.dot(s.dx);
+  const double contactNow = contactEnergy(s.xk, s.frictionEps);
+  step = 1.0;
+  for (int ls = 0; ls <= kMaxLineSearchHalvings; ++ls, step *= 0.5) {
+    applyStep(s, step);
+    evaluateEnergies(s.xTrial);
+    double deltaV = 0.0;
+    for (std::size_t i = 0; i < triangles.size(); ++i) deltaV += triTrial[i] - triEnergy[i];
+    for (std::size_t k = 0; k < hinges.size(); ++k) deltaV += hingeTrial[k] - hingeEnergy[k];
+    if (!contactPlanes.empty() || !faceContacts.empty())
+      deltaV += contactEnergy(s.xTrial, s.frictionEps) - contactNow;
+    const double deltaPhi = step * slopeQ + 0.5 * step * step * curvature + deltaV;
+    if (std::isfinite(deltaPhi) && deltaPhi <= kArmijo * step * slope)
+      return LineSearchResult::Accepted;
+  }
+  // Within a hundred tolerances of the solution the energy decrease of the
+  // Newton step is below Phi's rounding: the iterate is as converged as the
+  // arithmetic allows.
+  if (stepNorm <= 100.0 * tol) return LineSearchResult::Converged;
+  why = "line search found no decrease";
+  return LineSearchResult::Failed;
+}
+
+void ElasticSheet::Impl::traceNewtonIteration(const NewtonState& s, int it, double stepNorm,
+                                              double step, bool projected) const {
+  std::size_t worst = 0;
+  double wn = -1.0;
+  for (std::size_t i = 0; i < vertexCount; ++i) {
+    const int fi = freeIndex[i];
+    if (fi >= 0 && s.dx.segment<3>(3 * fi).norm() > wn) {
+      wn = s.dx.segment<3>(3 * fi).norm();
+      worst = i;
+    }
+  }
+  std::fprintf(stderr,
+               "[newton] h %.3g it %d step %.3e s %.3g worst v %zu mass %.3g (mean %.3g)%s\n", s.h,
+               it, stepNorm, step, worst, mass[worst],
+               std::accumulate(mass.begin(), mass.end(), 0.0) / static_cast<double>(vertexCount),
+               projected ? " projected" : "");
+}
+
+bool ElasticSheet::Impl::finishSubstep(NewtonState& s, StepStats& stats, std::string& why) {
+  if (!finite(s.xk)) {
+    why = "non-finite positions";
+    return false;
+  }
+  std::vector<Pushed> pushed;
+  lastContacts.clear();
+  if (!contactPlanes.empty() || !faceContacts.empty() || collidersOn())
+    resolveContacts(x, s.xk, s.h, stats, pushed);
+  for (std::size_t i = 0; i < vertexCount; ++i) {
+    v[i] = (s.xk[i] - x[i]) / s.h;
+    x[i] = s.xk[i];
+  }
+  // A pushed vertex keeps no velocity into the surface it was pushed out of
+  // (relative to that surface's own velocity).
+  for (const Pushed& p : pushed)
+    v[p.vertex] -= std::min(0.0, (v[p.vertex] - p.surfaceVelocity).dot(p.normal)) * p.normal;
+  trackBranches(x);
+  return true;
+}
+
+bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, StepStats& stats,
+                                 std::string& why) {
+  // Animated colliders: where the step begins, then where it ends.
+  if (collidersOn() && contact.moveColliders) {
+    contact.moveColliders(t0);
+    contact.moveColliders(t1);
+  }
+  if (!collectPins(t1, pins, why)) return false;
+  NewtonState s;
+  s.h = t1 - t0;
+  startNewton(s);
+  findContacts(x, s.xk, s.h, stats);
+  static const bool debugNewton = [] {
+    const char* e = std::getenv("CRUMPLE_DEBUG_NEWTON");
+    return e != nullptr && e[0] == '1';
+  }();
+  const double tol = params.newtonTolerance * typicalEdge;
+  // Nothing to solve when every vertex is pinned: the step is the pins.
+  bool converged = freeCount == 0;
+  for (int it = 0; !converged && it < params.maxNewtonIterations; ++it) {
+    // Exact element Hessians first (quadratic convergence); projected to PSD
+    // only if the assembled system turns out not to be positive definite.
+    evaluate(s.xk, true, false);
+    ++stats.newtonIterations;
+    if (!newtonGradient(s, why)) return false;
+    bool projected = false;
+    if (!newtonDirection(s, stats, projected, why)) return false;
+    const double stepNorm = s.dx.lpNorm<Eigen::Infinity>();
+    stats.finalStepNorm = stepNorm;
     if (stepNorm <= tol) {
-      applyStep(1.0);
-      xk.swap(xTrial);
+      applyStep(s, 1.0);
+      s.xk.swap(s.xTrial);
       converged = true;
       break;
     }
-
-    // Backtracking line search on Phi (Armijo).
-    const double slope = grad.dot(dx);
-    if (!(slope < 0.0)) {
-      why = "Newton direction is not a descent direction";
-      return false;
+    double step = 1.0;
+    const LineSearchResult found = lineSearch(s, stepNorm, tol, step, why);
+    if (found == LineSearchResult::Failed) return false;
+    if (found == LineSearchResult::Converged) {
+      converged = true;
+      break;
     }
-    // Exact change of the quadratic part: s gradQ.dx + s^2/2 dx^T Q dx.
-    double curvature = 0.0;
-    for (std::size_t i = 0; i < nv; ++i) {
-      const int fi = freeIndex[i];
-      if (fi >= 0) curvature += mass[i] * massDiag * dx.segment<3>(3 * fi).squaredNorm();
-    }
-    if (beta > 0.0) {
-      for (std::size_t i = 0; i < nv; ++i) {
-        const int fi = freeIndex[i];
-        disp[i] = fi >= 0 ? Vec3(dx.segment<3>(3 * fi)) : Vec3::Zero();
-      }
-      VecX kd = VecX::Zero(n);
-      dampProduct(disp, kd);
-      curvature += kd.dot(dx);
-    }
-    const double slopeQ = gradQ.dot(dx);
-    const double contactNow = contactEnergy(xk);
-    double s = 1.0;
-    bool accepted = false;
-    for (int ls = 0; ls <= kMaxLineSearchHalvings; ++ls, s *= 0.5) {
-      applyStep(s);
-      evaluateEnergies(xTrial);
-      double deltaV = 0.0;
-      for (std::size_t i = 0; i < triangles.size(); ++i) deltaV += triTrial[i] - triEnergy[i];
-      for (std::size_t k = 0; k < hinges.size(); ++k) deltaV += hingeTrial[k] - hingeEnergy[k];
-      if (!contactPlanes.empty() || !faceContacts.empty())
-        deltaV += contactEnergy(xTrial) - contactNow;
-      const double deltaPhi = s * slopeQ + 0.5 * s * s * curvature + deltaV;
-      if (std::isfinite(deltaPhi) && deltaPhi <= kArmijo * s * slope) {
-        accepted = true;
-        break;
-      }
-    }
-    if (!accepted) {
-      // Within a hundred tolerances of the solution the energy decrease of
-      // the Newton step is below Phi's rounding: the iterate is as converged
-      // as the arithmetic allows.
-      if (stepNorm <= 100.0 * tol) {
-        converged = true;
-        break;
-      }
-      why = "line search found no decrease";
-      return false;
-    }
-    if (debugNewton) {
-      std::size_t worst = 0;
-      double wn = -1.0;
-      for (std::size_t i = 0; i < nv; ++i) {
-        const int fi = freeIndex[i];
-        if (fi >= 0 && dx.segment<3>(3 * fi).norm() > wn) {
-          wn = dx.segment<3>(3 * fi).norm();
-          worst = i;
-        }
-      }
-      std::fprintf(
-          stderr, "[newton] h %.3g it %d step %.3e s %.3g worst v %zu mass %.3g (mean %.3g)%s\n", h,
-          it, stepNorm, s, worst, mass[worst], std::accumulate(mass.begin(), mass.end(), 0.0) / nv,
-          projected ? " projected" : "");
-    }
-    xk.swap(xTrial);
+    if (debugNewton) traceNewtonIteration(s, it, stepNorm, step, projected);
+    s.xk.swap(s.xTrial);
   }
   if (!converged) {
     std::ostringstream os;
@@ -332,24 +384,7 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
     why = os.str();
     return false;
   }
-  if (!finite(xk)) {
-    why = "non-finite positions";
-    return false;
-  }
-  std::vector<Pushed> pushed;
-  lastContacts.clear();
-  if (!contactPlanes.empty() || !faceContacts.empty() || collidersOn())
-    resolveContacts(xn, xk, h, stats, pushed);
-  for (std::size_t i = 0; i < nv; ++i) {
-    v[i] = (xk[i] - xn[i]) / h;
-    x[i] = xk[i];
-  }
-  // A pushed vertex keeps no velocity into the surface it was pushed out of
-  // (relative to that surface's own velocity).
-  for (const Pushed& p : pushed)
-    v[p.vertex] -= std::min(0.0, (v[p.vertex] - p.surfaceVelocity).dot(p.normal)) * p.normal;
-  trackBranches(x);
-  return true;
+  return finishSubstep(s, stats, why);
 }
 
 // Substep halving: a failed step is retried as two halves, recursively. The

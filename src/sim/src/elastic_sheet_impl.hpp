@@ -266,6 +266,51 @@ struct ElasticSheet::Impl {
   void evaluateEnergies(const std::vector<Vec3>& xs);
   void projectHessians();
   bool substep(double t0, double t1, const PinFunction& pins, StepStats& stats, std::string& why);
+  // One backward Euler substep over h from x_n = x (substep(),
+  // elastic_newton.cpp): the incremental potential's fixed parts, the
+  // Newton iterate and its scratch.
+  struct NewtonState {
+    double h = 0.0;
+    double massDiag = 0.0;     // lumped mass / damping diagonal: 1/h^2 + alpha/h
+    double dampScale = 0.0;    // Rayleigh stiffness damping beta / h
+    double frictionEps = 0.0;  // kFrictionSpeed h: static friction below it
+    std::vector<Vec3> xTilde, xk, xTrial, disp;
+    VecX gradQ, gradV, grad, dx;
+  };
+  // Reads the pins at t1 into pinBuffer / pinTarget and (re)builds the
+  // system when the pinned set changed. False with `why` on bad input.
+  bool collectPins(double t1, const PinFunction& pins, std::string& why);
+  // x~ = x_n + h v_n + h^2 g, the predictor as the first iterate, and the
+  // stiffness damping frozen at x_n.
+  void startNewton(NewtonState& s);
+  // out += beta/h K^_n u (Rayleigh damping with the stiffness frozen at x_n).
+  void dampProduct(const std::vector<Vec3>& u, double dampScale, VecX& out) const;
+  // Coulomb friction with the lagged normal force (IPC's smoothed friction
+  // potential, Li et al. 2020, Sec. 5): energy, and gradient and PSD
+  // Hessian block of one contact when asked.
+  static double frictionTerms(const ContactPlane& cp, const Vec3& xi, const Vec3& xni, double eps,
+                              Vec3* grad, Mat3* hess);
+  // Penalty and friction energy of the contacts at xs.
+  double contactEnergy(const std::vector<Vec3>& xs, double eps) const;
+  // The incremental potential's gradient at s.xk over the free DOFs (the
+  // element terms must have been evaluated there).
+  bool newtonGradient(NewtonState& s, std::string& why);
+  // The Hessian at s.xk into `matrix`; false when not finite.
+  bool assembleSystem(const NewtonState& s);
+  // s.dx = -H^-1 grad, the element blocks projected to PSD when H is not
+  // positive definite. Sets `projected`.
+  bool newtonDirection(NewtonState& s, StepStats& stats, bool& projected, std::string& why);
+  // s.xTrial = s.xk + step s.dx over the free DOFs.
+  void applyStep(NewtonState& s, double step) const;
+  // Backtracking (Armijo) line search along s.dx; the accepted point is left
+  // in s.xTrial and its length in `step`.
+  enum class LineSearchResult { Accepted, Converged, Failed };
+  LineSearchResult lineSearch(NewtonState& s, double stepNorm, double tol, double& step,
+                              std::string& why);
+  void traceNewtonIteration(const NewtonState& s, int it, double stepNorm, double step,
+                            bool projected) const;
+  // Contacts' failsafe, velocities and the new state from the converged s.xk.
+  bool finishSubstep(NewtonState& s, StepStats& stats, std::string& why);
   bool stepRecursive(double t0, double t1, const PinFunction& pins, int depth, StepStats& stats,
                      std::string& why);
   double hingeStiffnessOf(std::size_t k) const { return hingeBase[k] * hingeFactor[k]; }
