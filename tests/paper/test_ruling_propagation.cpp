@@ -329,3 +329,49 @@ TEST(RulingPropagation, TiltedRollOfAStripKeepsRulingEndsApart) {
     }
   }
 }
+
+// A strip whose rulings run past a corner of the sheet (paper Appendix B):
+// the corner lies between two consecutive ruling ends on one border, so a
+// cell between them would have five sides. The cell is split by a ruling
+// through the corner and the roll still becomes a curved region, whatever the
+// tilt (the strip was declined, and the sheet stayed one flat region while
+// its S_P bent: docs/CRUMPLING.md "The flap was a declined strip").
+TEST(RulingPropagation, RollPastASheetCornerSplitsTheCellAtTheCorner) {
+  for (int step = 0; step <= 40; ++step) {
+    const double degrees = 2.0 + 0.5 * step;
+    const double tilt = degrees * std::numbers::pi / 180.0;
+    const Vec2 axis(std::sin(tilt), std::cos(tilt));  // pattern direction of the rulings
+    const Vec2 across(axis.y(), -axis.x());
+    const auto roll = [&](const Vec2& p) {
+      const double u = (p - Vec2(0.5 * kL, 0.5 * kL)).dot(across);
+      const double v = (p - Vec2(0.5 * kL, 0.5 * kL)).dot(axis);
+      return Vec3(0.04 * std::sin(u / 0.04), v, 0.04 * (1.0 - std::cos(u / 0.04)));
+    };
+    InitialSheet sheet = makeFlatSheet(kL, kL, {}, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
+    GeometricMesh& g = sheet.mesh;
+    deform(g, roll);
+    CrumpleParams params;
+    GeometricStepStats stats;
+    std::uint64_t draw = 0;
+    const BoundaryPosition boundary = [&](double s) { return roll(outlinePoint(g, s)); };
+    treatCompression(g, params, boundary, CounterRng(1, 0, RngPurpose::SingularityPlacement),
+                     draw, stats);
+    ASSERT_EQ(validate(g), "") << degrees << " degrees";
+    EXPECT_GE(stats.curvedCreated, 1) << degrees << " degrees";
+    EXPECT_EQ(countSingular(g), 0) << degrees << " degrees";
+    // Every ruling lies along the roll's axis within the spread a ruling
+    // through a corner takes (it joins the corner to an end of its
+    // neighbour), and its 3D length is its pattern length (a straight line
+    // on the cylinder).
+    for (const Region& region : g.regions) {
+      if (region.type != mesh::RegionType::Curved) continue;
+      for (const Ruling& r : region.rulings) {
+        const GeometricVertex& a = g.vertices[static_cast<std::size_t>(r.a)];
+        const GeometricVertex& b = g.vertices[static_cast<std::size_t>(r.b)];
+        const Vec2 d = (b.pattern - a.pattern).normalized();
+        EXPECT_GT(std::abs(d.dot(axis)), std::cos(20.0 * std::numbers::pi / 180.0))
+            << degrees << " degrees";
+      }
+    }
+  }
+}
