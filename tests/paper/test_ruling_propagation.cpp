@@ -59,6 +59,35 @@ void expectRulingEndsApart(const GeometricMesh& g, const CrumpleParams& params) 
   }
 }
 
+// A w x h sheet rolled around a cylinder of radius r whose axis runs through
+// the sheet's centre at `tilt` from the pattern's y axis, its compression
+// treated with the outline placed on the cylinder.
+struct TreatedRoll {
+  InitialSheet sheet;
+  GeometricStepStats stats;
+  Vec2 axis;  // pattern direction of the rulings
+};
+
+TreatedRoll treatTiltedRoll(double w, double h, double r, double tilt) {
+  TreatedRoll out{makeFlatSheet(w, h, {}, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY()),
+                  {},
+                  Vec2(std::sin(tilt), std::cos(tilt))};
+  const Vec2 axis = out.axis;
+  const Vec2 across(axis.y(), -axis.x());
+  const auto roll = [&](const Vec2& p) {
+    const double u = (p - Vec2(0.5 * w, 0.5 * h)).dot(across);
+    const double v = (p - Vec2(0.5 * w, 0.5 * h)).dot(axis);
+    return Vec3(r * std::sin(u / r), v, r * (1.0 - std::cos(u / r)));
+  };
+  GeometricMesh& g = out.sheet.mesh;
+  deform(g, roll);
+  std::uint64_t draw = 0;
+  const BoundaryPosition boundary = [&](double s) { return roll(outlinePoint(g, s)); };
+  treatCompression(g, CrumpleParams{}, boundary, CounterRng(1, 0, RngPurpose::SingularityPlacement),
+                   draw, out.stats);
+  return out;
+}
+
 }  // namespace
 
 TEST(RulingPropagation, UncompressedSheetIsLeftAlone) {
@@ -293,23 +322,10 @@ TEST(RulingPropagation, JunctionMovesIntoTheFlatRegionAboveThetaHigh) {
 // solve.
 TEST(RulingPropagation, TiltedRollOfAStripKeepsRulingEndsApart) {
   constexpr double kW = 0.24, kH = 0.03, kR = 0.05;
-  const double tilt = 3.0 * std::numbers::pi / 180.0;
-  const Vec2 axis(std::sin(tilt), std::cos(tilt));  // pattern direction of the rulings
-  const Vec2 across(axis.y(), -axis.x());
-  const auto roll = [&](const Vec2& p) {
-    const double u = (p - Vec2(0.5 * kW, 0.5 * kH)).dot(across);
-    const double v = (p - Vec2(0.5 * kW, 0.5 * kH)).dot(axis);
-    return Vec3(kR * std::sin(u / kR), v, kR * (1.0 - std::cos(u / kR)));
-  };
-  InitialSheet sheet = makeFlatSheet(kW, kH, {}, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
-  GeometricMesh& g = sheet.mesh;
-  deform(g, roll);
-  CrumpleParams params;
-  GeometricStepStats stats;
-  std::uint64_t draw = 0;
-  const BoundaryPosition boundary = [&](double s) { return roll(outlinePoint(g, s)); };
-  treatCompression(g, params, boundary, CounterRng(1, 0, RngPurpose::SingularityPlacement), draw,
-                   stats);
+  const TreatedRoll rolled = treatTiltedRoll(kW, kH, kR, 3.0 * std::numbers::pi / 180.0);
+  const GeometricMesh& g = rolled.sheet.mesh;
+  const GeometricStepStats& stats = rolled.stats;
+  const CrumpleParams params;
   ASSERT_EQ(validate(g), "");
   ASSERT_GE(stats.curvedCreated, 1);
   EXPECT_EQ(countSingular(g), 0);
@@ -339,23 +355,10 @@ TEST(RulingPropagation, TiltedRollOfAStripKeepsRulingEndsApart) {
 TEST(RulingPropagation, RollPastASheetCornerSplitsTheCellAtTheCorner) {
   for (int step = 0; step <= 40; ++step) {
     const double degrees = 2.0 + 0.5 * step;
-    const double tilt = degrees * std::numbers::pi / 180.0;
-    const Vec2 axis(std::sin(tilt), std::cos(tilt));  // pattern direction of the rulings
-    const Vec2 across(axis.y(), -axis.x());
-    const auto roll = [&](const Vec2& p) {
-      const double u = (p - Vec2(0.5 * kL, 0.5 * kL)).dot(across);
-      const double v = (p - Vec2(0.5 * kL, 0.5 * kL)).dot(axis);
-      return Vec3(0.04 * std::sin(u / 0.04), v, 0.04 * (1.0 - std::cos(u / 0.04)));
-    };
-    InitialSheet sheet = makeFlatSheet(kL, kL, {}, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
-    GeometricMesh& g = sheet.mesh;
-    deform(g, roll);
-    CrumpleParams params;
-    GeometricStepStats stats;
-    std::uint64_t draw = 0;
-    const BoundaryPosition boundary = [&](double s) { return roll(outlinePoint(g, s)); };
-    treatCompression(g, params, boundary, CounterRng(1, 0, RngPurpose::SingularityPlacement),
-                     draw, stats);
+    const TreatedRoll rolled = treatTiltedRoll(kL, kL, 0.04, degrees * std::numbers::pi / 180.0);
+    const GeometricMesh& g = rolled.sheet.mesh;
+    const GeometricStepStats& stats = rolled.stats;
+    const Vec2& axis = rolled.axis;
     ASSERT_EQ(validate(g), "") << degrees << " degrees";
     EXPECT_GE(stats.curvedCreated, 1) << degrees << " degrees";
     EXPECT_EQ(countSingular(g), 0) << degrees << " degrees";
