@@ -275,6 +275,133 @@ std::vector<double> stripParameters(const Context& c, const Pencil& pencil, doub
   return filled;
 }
 
+// The loop path from x forwards to y (inclusive) along `loop`.
+std::vector<int> loopPath(const std::vector<int>& loop, int x, int y) {
+  std::vector<int> out;
+  auto k = static_cast<std::size_t>(std::find(loop.begin(), loop.end(), x) - loop.begin());
+  for (std::size_t n = 0; n <= loop.size(); ++n) {
+    out.push_back(loop[k]);
+    if (loop[k] == y) break;
+    k = (k + 1) % loop.size();
+  }
+  return out;
+}
+
+// A sheet corner strictly between two consecutive ruling ends (the
+// spacing rule dropped the chord through it) would make a cell of five or
+// more sides. Such a cell is split by rulings through the corner, each
+// joined to a vertex of the other chain, as a ruled surface's rulings join
+// its two boundary curves (do Carmo 1976, Sec. 3-5); every cell is then a
+// triangle or a quad. Any other vertex there (a handle, an earlier
+// ruling's end) still declines the strip (docs/CRUMPLING.md "The flap was
+// a declined strip").
+// Returns false (the strip is declined) when a cell cannot be split so.
+bool splitCellsAtCorners(const GeometricMesh& g, const Loop& loop, const std::vector<int>& newLoop,
+                         const CrumpleParams& params, std::vector<Ruling>& rulings) {
+  const auto P = [&](int v) -> const Vec2& {
+    return g.vertices[static_cast<std::size_t>(v)].pattern;
+  };
+  // The loop path from x to y that passes neither ox nor oy (the other
+  // chain's ends), inclusive; empty when there is none.
+  const auto chain = [&](int x, int y, int ox, int oy) {
+    if (x == y) return std::vector<int>{x};
+    std::vector<int> best;
+    std::vector<int> backwards = loopPath(newLoop, y, x);
+    std::reverse(backwards.begin(), backwards.end());
+    for (const std::vector<int>& p : {loopPath(newLoop, x, y), backwards}) {
+      if (p.size() < 2 || p.front() != x || p.back() != y) continue;
+      bool clear = true;
+      for (std::size_t k = 1; k + 1 < p.size(); ++k)
+        if ((p[k] == ox && ox != x && ox != y) || (p[k] == oy && oy != x && oy != y)) clear = false;
+      if (clear && (best.empty() || p.size() < best.size())) best = p;
+    }
+    return best;
+  };
+  // Whether the segment (x, y) crosses a loop edge away from its ends.
+  const auto crossesLoop = [&](int x, int y) {
+    const Vec2 a = P(x), b = P(y);
+    for (std::size_t k = 0; k < newLoop.size(); ++k) {
+      const int u = newLoop[k], w = newLoop[(k + 1) % newLoop.size()];
+      if (u == x || u == y || w == x || w == y) continue;
+      const double d1 = cross2(b - a, P(u) - a), d2 = cross2(b - a, P(w) - a);
+      const double d3 = cross2(P(w) - P(u), a - P(u)), d4 = cross2(P(w) - P(u), b - P(u));
+      if (((d1 > 0.0) != (d2 > 0.0)) && ((d3 > 0.0) != (d4 > 0.0))) return true;
+    }
+    return !insideLoop(g, loop, 0.5 * (a + b));
+  };
+  // The width of the cell between rulings (a0, b0) and (a1, b1): twice its
+  // area over its longest side (0 when degenerate).
+  const auto cellWidth = [&](int a0, int b0, int a1, int b1) {
+    std::vector<int> poly{a0, a1, b1, b0};
+    poly.erase(std::unique(poly.begin(), poly.end()), poly.end());
+    if (poly.size() > 1 && poly.front() == poly.back()) poly.pop_back();
+    if (poly.size() < 3) return 0.0;
+    double area = 0.0, longest = 0.0;
+    for (std::size_t q = 0; q < poly.size(); ++q) {
+      const Vec2& u = P(poly[q]);
+      const Vec2& w = P(poly[(q + 1) % poly.size()]);
+      area += cross2(u, w);
+      longest = std::max(longest, (w - u).norm());
+    }
+    return longest > 0.0 ? std::abs(area) / longest : 0.0;
+  };
+  // Each cell between consecutive rulings is zipped: a monotone walk along
+  // both chains, one ruling per step, that keeps the thinnest cell widest
+  // (a cell thinner than a quarter of the ruling spacing is a sliver that
+  // stalls the elastic solve, as in the spacing rule above).
+  const double minWidth = 0.25 / params.rhoBound;
+  std::vector<Ruling> zipped{rulings.front()};
+  for (std::size_t k = 0; k + 1 < rulings.size(); ++k) {
+    const Ruling& r0 = rulings[k];
+    const Ruling& r1 = rulings[k + 1];
+    const std::vector<int> ca = chain(r0.a, r1.a, r0.b, r1.b);
+    const std::vector<int> cb = chain(r0.b, r1.b, r0.a, r1.a);
+    if (ca.empty() || cb.empty()) return false;
+    if (ca.size() <= 2 && cb.size() <= 2) {
+      zipped.push_back(r1);
+      continue;
+    }
+    for (const std::vector<int>* c : {&ca, &cb})
+      for (std::size_t q = 1; q + 1 < c->size(); ++q)
+        if (!g.vertices[static_cast<std::size_t>((*c)[q])].corner) return false;
+    // best[i][j]: the widest thinnest cell of a walk from (0, 0) to ruling
+    // (ca[i], cb[j]); from[i][j] the step taken into it.
+    const std::size_t na = ca.size(), nb = cb.size();
+    std::vector<double> best(na * nb, -1.0);
+    std::vector<int> from(na * nb, -1);
+    best[0] = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < na; ++i) {
+      for (std::size_t j = 0; j < nb; ++j) {
+        if (i + j == 0) continue;
+        const bool last = i + 1 == na && j + 1 == nb;
+        if (!last && (ca[i] == cb[j] || crossesLoop(ca[i], cb[j]))) continue;
+        for (int step = 0; step < 3; ++step) {  // 0: along a, 1: along b, 2: both
+          if ((step != 1 && i == 0) || (step != 0 && j == 0)) continue;
+          const std::size_t pi = step != 1 ? i - 1 : i, pj = step != 0 ? j - 1 : j;
+          const double before = best[pi * nb + pj];
+          if (before < 0.0) continue;
+          const double w = std::min(before, cellWidth(ca[pi], cb[pj], ca[i], cb[j]));
+          if (w > best[i * nb + j]) {
+            best[i * nb + j] = w;
+            from[i * nb + j] = step;
+          }
+        }
+      }
+    }
+    if (best[na * nb - 1] < minWidth) return false;
+    std::vector<Ruling> walk;
+    for (std::size_t i = na - 1, j = nb - 1; i + j > 0;) {
+      walk.push_back({ca[i], cb[j]});
+      const int step = from[i * nb + j];
+      if (step != 1) --i;
+      if (step != 0) --j;
+    }
+    zipped.insert(zipped.end(), walk.rbegin(), walk.rend());
+  }
+  rulings = std::move(zipped);
+  return true;
+}
+
 }  // namespace
 
 // Appendix A: walks from the compressed triangle's centroid along +-dir to
@@ -477,20 +604,7 @@ StripResult remeshStrip(GeometricMesh& g, int region, const Pencil& pencil,
     std::sort(list.begin(), list.end());
     for (const auto& [u, v] : list) newLoop.push_back(v);
   }
-  const auto position = [&](int v) {
-    return static_cast<std::size_t>(std::find(newLoop.begin(), newLoop.end(), v) - newLoop.begin());
-  };
-  // The loop path from x forwards to y (inclusive).
-  const auto path = [&](int x, int y) {
-    std::vector<int> out;
-    std::size_t k = position(x);
-    for (std::size_t n = 0; n <= newLoop.size(); ++n) {
-      out.push_back(newLoop[k]);
-      if (newLoop[k] == y) break;
-      k = (k + 1) % newLoop.size();
-    }
-    return out;
-  };
+  const auto path = [&](int x, int y) { return loopPath(newLoop, x, y); };
   const auto contains = [](const std::vector<int>& list, int v) {
     return std::find(list.begin(), list.end(), v) != list.end();
   };
@@ -506,118 +620,8 @@ StripResult remeshStrip(GeometricMesh& g, int region, const Pencil& pencil,
     std::vector<int>& side = contains(p1, innerProbe) ? p2 : p1;
     if (side.size() >= 3) sides.push_back(side);
   }
-  // A sheet corner strictly between two consecutive ruling ends (the
-  // spacing rule dropped the chord through it) would make a cell of five or
-  // more sides. Such a cell is split by rulings through the corner, each
-  // joined to a vertex of the other chain, as a ruled surface's rulings join
-  // its two boundary curves (do Carmo 1976, Sec. 3-5); every cell is then a
-  // triangle or a quad. Any other vertex there (a handle, an earlier
-  // ruling's end) still declines the strip (docs/CRUMPLING.md "The flap was
-  // a declined strip").
-  const auto P = [&](int v) -> const Vec2& {
-    return g.vertices[static_cast<std::size_t>(v)].pattern;
-  };
-  // The loop path from x to y that passes neither ox nor oy (the other
-  // chain's ends), inclusive; empty when there is none.
-  const auto chain = [&](int x, int y, int ox, int oy) {
-    if (x == y) return std::vector<int>{x};
-    std::vector<int> best;
-    std::vector<int> backwards = path(y, x);
-    std::reverse(backwards.begin(), backwards.end());
-    for (const std::vector<int>& p : {path(x, y), backwards}) {
-      if (p.size() < 2 || p.front() != x || p.back() != y) continue;
-      bool clear = true;
-      for (std::size_t k = 1; k + 1 < p.size(); ++k)
-        if ((p[k] == ox && ox != x && ox != y) || (p[k] == oy && oy != x && oy != y)) clear = false;
-      if (clear && (best.empty() || p.size() < best.size())) best = p;
-    }
-    return best;
-  };
-  // Whether the segment (x, y) crosses a loop edge away from its ends.
-  const auto crossesLoop = [&](int x, int y) {
-    const Vec2 a = P(x), b = P(y);
-    for (std::size_t k = 0; k < newLoop.size(); ++k) {
-      const int u = newLoop[k], w = newLoop[(k + 1) % newLoop.size()];
-      if (u == x || u == y || w == x || w == y) continue;
-      const double d1 = cross2(b - a, P(u) - a), d2 = cross2(b - a, P(w) - a);
-      const double d3 = cross2(P(w) - P(u), a - P(u)), d4 = cross2(P(w) - P(u), b - P(u));
-      if (((d1 > 0.0) != (d2 > 0.0)) && ((d3 > 0.0) != (d4 > 0.0))) return true;
-    }
-    return !insideLoop(g, loop, 0.5 * (a + b));
-  };
-  // The width of the cell between rulings (a0, b0) and (a1, b1): twice its
-  // area over its longest side (0 when degenerate).
-  const auto cellWidth = [&](int a0, int b0, int a1, int b1) {
-    std::vector<int> poly{a0, a1, b1, b0};
-    poly.erase(std::unique(poly.begin(), poly.end()), poly.end());
-    if (poly.size() > 1 && poly.front() == poly.back()) poly.pop_back();
-    if (poly.size() < 3) return 0.0;
-    double area = 0.0, longest = 0.0;
-    for (std::size_t q = 0; q < poly.size(); ++q) {
-      const Vec2& u = P(poly[q]);
-      const Vec2& w = P(poly[(q + 1) % poly.size()]);
-      area += cross2(u, w);
-      longest = std::max(longest, (w - u).norm());
-    }
-    return longest > 0.0 ? std::abs(area) / longest : 0.0;
-  };
-  // Each cell between consecutive rulings is zipped: a monotone walk along
-  // both chains, one ruling per step, that keeps the thinnest cell widest
-  // (a cell thinner than a quarter of the ruling spacing is a sliver that
-  // stalls the elastic solve, as in the spacing rule above).
-  const double minWidth = 0.25 / params.rhoBound;
-  std::vector<Ruling> zipped{rulings.front()};
-  for (std::size_t k = 0; k + 1 < rulings.size(); ++k) {
-    const Ruling& r0 = rulings[k];
-    const Ruling& r1 = rulings[k + 1];
-    const std::vector<int> ca = chain(r0.a, r1.a, r0.b, r1.b);
-    const std::vector<int> cb = chain(r0.b, r1.b, r0.a, r1.a);
-    if (ca.empty() || cb.empty())
-      return {false, "a strip cell would hold an extra boundary vertex"};
-    if (ca.size() <= 2 && cb.size() <= 2) {
-      zipped.push_back(r1);
-      continue;
-    }
-    for (const std::vector<int>* c : {&ca, &cb})
-      for (std::size_t q = 1; q + 1 < c->size(); ++q)
-        if (!g.vertices[static_cast<std::size_t>((*c)[q])].corner)
-          return {false, "a strip cell would hold an extra boundary vertex"};
-    // best[i][j]: the widest thinnest cell of a walk from (0, 0) to ruling
-    // (ca[i], cb[j]); from[i][j] the step taken into it.
-    const std::size_t na = ca.size(), nb = cb.size();
-    std::vector<double> best(na * nb, -1.0);
-    std::vector<int> from(na * nb, -1);
-    best[0] = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < na; ++i) {
-      for (std::size_t j = 0; j < nb; ++j) {
-        if (i + j == 0) continue;
-        const bool last = i + 1 == na && j + 1 == nb;
-        if (!last && (ca[i] == cb[j] || crossesLoop(ca[i], cb[j]))) continue;
-        for (int step = 0; step < 3; ++step) {  // 0: along a, 1: along b, 2: both
-          if ((step != 1 && i == 0) || (step != 0 && j == 0)) continue;
-          const std::size_t pi = step != 1 ? i - 1 : i, pj = step != 0 ? j - 1 : j;
-          const double before = best[pi * nb + pj];
-          if (before < 0.0) continue;
-          const double w = std::min(before, cellWidth(ca[pi], cb[pj], ca[i], cb[j]));
-          if (w > best[i * nb + j]) {
-            best[i * nb + j] = w;
-            from[i * nb + j] = step;
-          }
-        }
-      }
-    }
-    if (best[na * nb - 1] < minWidth)
-      return {false, "a strip cell would hold an extra boundary vertex"};
-    std::vector<Ruling> walk;
-    for (std::size_t i = na - 1, j = nb - 1; i + j > 0;) {
-      walk.push_back({ca[i], cb[j]});
-      const int step = from[i * nb + j];
-      if (step != 1) --i;
-      if (step != 0) --j;
-    }
-    zipped.insert(zipped.end(), walk.rbegin(), walk.rend());
-  }
-  rulings = std::move(zipped);
+  if (!splitCellsAtCorners(g, loop, newLoop, params, rulings))
+    return {false, "a strip cell would hold an extra boundary vertex"};
   // Commit: drop F's faces, add the flat sides and the curved strip.
   removeRegionFaces(g, region);
   for (const std::vector<int>& side : sides) {
