@@ -275,6 +275,72 @@ std::vector<double> stripParameters(const Context& c, const Pencil& pencil, doub
   return filled;
 }
 
+// Ruling ends at least half the ruling spacing apart on both borders (or
+// one shared vertex, a fan's apex): a conical pencil spaced at 1/rho_bound
+// on its far border crowds its near border, and ends millimetres apart
+// make sliver cells that stall the elastic solve. The limit rulings stay.
+// Chord ends within a quarter of the ruling spacing of a loop vertex move
+// onto it (a new vertex beside an existing one would make slivers); a chord
+// that then runs along part of a loop edge is no ruling and is dropped.
+// Returns false when fewer than two chords are left.
+bool spaceChords(const GeometricMesh& g, const Loop& loop, double tol, const CrumpleParams& params,
+                 std::vector<Chord>& chords) {
+  {
+    const double snap = 0.25 / params.rhoBound;
+    const int m = static_cast<int>(loop.size());
+    const auto snapEnd = [&](ChordEnd& e) {
+      if (e.vertex >= 0) return;
+      const int a = e.loopEdge;
+      const int b = (a + 1) % m;
+      for (int k : {a, b}) {
+        const Vec2& p =
+            g.vertices[static_cast<std::size_t>(loop.v[static_cast<std::size_t>(k)])].pattern;
+        if ((e.p - p).norm() < snap) {
+          e.p = p;
+          e.vertex = k;
+          e.loopEdge = -1;
+          return;
+        }
+      }
+    };
+    const auto alongLoop = [&](const ChordEnd& x, const ChordEnd& y) {
+      if (x.loopEdge >= 0 && y.loopEdge >= 0) return x.loopEdge == y.loopEdge;
+      const ChordEnd& onEdge = x.loopEdge >= 0 ? x : y;
+      const ChordEnd& atVertex = x.loopEdge >= 0 ? y : x;
+      if (onEdge.loopEdge < 0) return false;  // both at vertices: handled by evaluateChord
+      return atVertex.vertex == onEdge.loopEdge || atVertex.vertex == (onEdge.loopEdge + 1) % m;
+    };
+    std::vector<Chord> kept;
+    for (Chord c : chords) {
+      snapEnd(c.a);
+      snapEnd(c.b);
+      if (c.a.vertex >= 0 && c.a.vertex == c.b.vertex) continue;
+      if (alongLoop(c.a, c.b)) continue;
+      kept.push_back(c);
+    }
+    chords = std::move(kept);
+    if (chords.size() < 2) return false;
+  }
+  {
+    const double minGap = 0.5 / params.rhoBound;
+    const auto apart = [&](const ChordEnd& x, const ChordEnd& y) {
+      const double d = (x.p - y.p).norm();
+      return d < tol || d >= minGap;
+    };
+    const auto spaced = [&](const Chord& x, const Chord& y) {
+      return apart(x.a, y.a) && apart(x.b, y.b);
+    };
+    std::vector<Chord> kept{chords.front()};
+    for (std::size_t k = 1; k + 1 < chords.size(); ++k) {
+      if (spaced(kept.back(), chords[k]) && spaced(chords[k], chords.back()))
+        kept.push_back(chords[k]);
+    }
+    if (chords.size() > 1) kept.push_back(chords.back());
+    chords = std::move(kept);
+  }
+  return true;
+}
+
 // The loop path from x forwards to y (inclusive) along `loop`.
 std::vector<int> loopPath(const std::vector<int>& loop, int x, int y) {
   std::vector<int> out;
@@ -477,66 +543,8 @@ StripResult remeshStrip(GeometricMesh& g, int region, const Pencil& pencil,
   const double width = std::max((chords.back().a.p - chords.front().a.p).norm(),
                                 (chords.back().b.p - chords.front().b.p).norm());
   if (width < 0.1 / params.rhoBound) return {false, "strip too narrow"};
-  // Ruling ends at least half the ruling spacing apart on both borders (or
-  // one shared vertex, a fan's apex): a conical pencil spaced at 1/rho_bound
-  // on its far border crowds its near border, and ends millimetres apart
-  // make sliver cells that stall the elastic solve. The limit rulings stay.
-  // Chord ends within a quarter of the ruling spacing of a loop vertex move
-  // onto it (a new vertex beside an existing one would make slivers); a chord
-  // that then runs along part of a loop edge is no ruling and is dropped.
-  {
-    const double snap = 0.25 / params.rhoBound;
-    const int m = static_cast<int>(loop.size());
-    const auto snapEnd = [&](ChordEnd& e) {
-      if (e.vertex >= 0) return;
-      const int a = e.loopEdge;
-      const int b = (a + 1) % m;
-      for (int k : {a, b}) {
-        const Vec2& p =
-            g.vertices[static_cast<std::size_t>(loop.v[static_cast<std::size_t>(k)])].pattern;
-        if ((e.p - p).norm() < snap) {
-          e.p = p;
-          e.vertex = k;
-          e.loopEdge = -1;
-          return;
-        }
-      }
-    };
-    const auto alongLoop = [&](const ChordEnd& x, const ChordEnd& y) {
-      if (x.loopEdge >= 0 && y.loopEdge >= 0) return x.loopEdge == y.loopEdge;
-      const ChordEnd& onEdge = x.loopEdge >= 0 ? x : y;
-      const ChordEnd& atVertex = x.loopEdge >= 0 ? y : x;
-      if (onEdge.loopEdge < 0) return false;  // both at vertices: handled by evaluateChord
-      return atVertex.vertex == onEdge.loopEdge || atVertex.vertex == (onEdge.loopEdge + 1) % m;
-    };
-    std::vector<Chord> kept;
-    for (Chord c : chords) {
-      snapEnd(c.a);
-      snapEnd(c.b);
-      if (c.a.vertex >= 0 && c.a.vertex == c.b.vertex) continue;
-      if (alongLoop(c.a, c.b)) continue;
-      kept.push_back(c);
-    }
-    chords = std::move(kept);
-    if (chords.size() < 2) return {false, "strip has fewer than two distinct rulings"};
-  }
-  {
-    const double minGap = 0.5 / params.rhoBound;
-    const auto apart = [&](const ChordEnd& x, const ChordEnd& y) {
-      const double d = (x.p - y.p).norm();
-      return d < ctx.tol || d >= minGap;
-    };
-    const auto spaced = [&](const Chord& x, const Chord& y) {
-      return apart(x.a, y.a) && apart(x.b, y.b);
-    };
-    std::vector<Chord> kept{chords.front()};
-    for (std::size_t k = 1; k + 1 < chords.size(); ++k) {
-      if (spaced(kept.back(), chords[k]) && spaced(chords[k], chords.back()))
-        kept.push_back(chords[k]);
-    }
-    if (chords.size() > 1) kept.push_back(chords.back());
-    chords = std::move(kept);
-  }
+  if (!spaceChords(g, loop, ctx.tol, params, chords))
+    return {false, "strip has fewer than two distinct rulings"};
 
   // Vertices for the chord ends: existing loop vertices, or new ones on dS
   // edges (several per edge are kept in order along it).
