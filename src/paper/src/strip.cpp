@@ -275,6 +275,27 @@ std::vector<double> stripParameters(const Context& c, const Pencil& pencil, doub
   return filled;
 }
 
+// The pattern cell between rulings r0 and r1 (a quad, or a triangle where
+// they share an end): its area and its longest side.
+struct CellShape {
+  double area = 0.0;
+  double longest = 0.0;
+};
+
+CellShape cellShape(const GeometricMesh& g, const Ruling& r0, const Ruling& r1) {
+  std::vector<int> poly{r0.a, r1.a, r1.b, r0.b};
+  poly.erase(std::unique(poly.begin(), poly.end()), poly.end());
+  if (poly.size() > 1 && poly.front() == poly.back()) poly.pop_back();
+  double twiceArea = 0.0, longest = 0.0;
+  for (std::size_t k = 0; k < poly.size(); ++k) {
+    const Vec2& u = g.vertices[static_cast<std::size_t>(poly[k])].pattern;
+    const Vec2& w = g.vertices[static_cast<std::size_t>(poly[(k + 1) % poly.size()])].pattern;
+    twiceArea += cross2(u, w);
+    longest = std::max(longest, (w - u).norm());
+  }
+  return {std::abs(0.5 * twiceArea), longest};
+}
+
 // Ruling ends at least half the ruling spacing apart on both borders (or
 // one shared vertex, a fan's apex): a conical pencil spaced at 1/rho_bound
 // on its far border crowds its near border, and ends millimetres apart
@@ -398,18 +419,8 @@ bool splitCellsAtCorners(const GeometricMesh& g, const Loop& loop, const std::ve
   // The width of the cell between rulings (a0, b0) and (a1, b1): twice its
   // area over its longest side (0 when degenerate).
   const auto cellWidth = [&](int a0, int b0, int a1, int b1) {
-    std::vector<int> poly{a0, a1, b1, b0};
-    poly.erase(std::unique(poly.begin(), poly.end()), poly.end());
-    if (poly.size() > 1 && poly.front() == poly.back()) poly.pop_back();
-    if (poly.size() < 3) return 0.0;
-    double area = 0.0, longest = 0.0;
-    for (std::size_t q = 0; q < poly.size(); ++q) {
-      const Vec2& u = P(poly[q]);
-      const Vec2& w = P(poly[(q + 1) % poly.size()]);
-      area += cross2(u, w);
-      longest = std::max(longest, (w - u).norm());
-    }
-    return longest > 0.0 ? std::abs(area) / longest : 0.0;
+    const CellShape c = cellShape(g, {a0, b0}, {a1, b1});
+    return c.longest > 0.0 ? 2.0 * c.area / c.longest : 0.0;
   };
   // Each cell between consecutive rulings is zipped: a monotone walk along
   // both chains, one ruling per step, that keeps the thinnest cell widest
@@ -577,22 +588,10 @@ StripResult remeshStrip(GeometricMesh& g, int region, const Pencil& pencil,
   // Drop rulings that would make a cell of (near) zero area, e.g. two chord
   // ends snapped onto one vertex next to a cone apex.
   {
-    const auto P = [&](int v) -> const Vec2& {
-      return g.vertices[static_cast<std::size_t>(v)].pattern;
-    };
-    const auto cellArea = [&](const Ruling& r0, const Ruling& r1) {
-      std::vector<int> poly{r0.a, r1.a, r1.b, r0.b};
-      poly.erase(std::unique(poly.begin(), poly.end()), poly.end());
-      if (poly.size() > 1 && poly.front() == poly.back()) poly.pop_back();
-      double area = 0.0;
-      for (std::size_t k = 0; k < poly.size(); ++k)
-        area += cross2(P(poly[k]), P(poly[(k + 1) % poly.size()]));
-      return std::abs(0.5 * area);
-    };
     const double minArea = 1e-4 / (params.rhoBound * params.rhoBound);
     std::vector<Ruling> kept;
     for (std::size_t k = 0; k < rulings.size(); ++k) {
-      if (!kept.empty() && cellArea(kept.back(), rulings[k]) < minArea) {
+      if (!kept.empty() && cellShape(g, kept.back(), rulings[k]).area < minArea) {
         if (k + 1 == rulings.size() && kept.size() > 1)
           kept.back() = rulings[k];  // keep the limit ruling
         continue;
