@@ -17,7 +17,7 @@
 namespace crumple::pipeline {
 namespace {
 
-constexpr std::uint32_t kCheckpointVersion = 3;
+constexpr std::uint32_t kCheckpointVersion = 4;
 constexpr char kMagic[9] = "CRUMPCKP";
 
 std::uint32_t sceneHash(const io::SceneSpec& scene) {
@@ -116,6 +116,9 @@ void saveReport(StateWriter& w, const ShotReport& r) {
   w.i64(r.elasticRetries);
   w.i64(r.strainLimitRuns);
   w.i64(r.strainLimitCarried);
+  w.i64(r.elasticHeldStill);
+  w.i32(r.elasticHeldFirst);
+  w.i32(r.elasticHeldLast);
   w.i32(r.lagFrames);
   w.f64(r.maxHandleLag);
   w.i32(r.maxHandleLagFrame);
@@ -159,6 +162,11 @@ void restoreReport(StateReader& in, ShotReport& r) {
   r.elasticRetries = in.i64();
   r.strainLimitRuns = in.i64();
   r.strainLimitCarried = in.i64();
+  r.elasticHeldStill = in.i64();
+  r.elasticHeldFirst = in.i32();
+  r.elasticHeldLast = in.i32();
+  if (r.elasticHeldStill < 0 || r.elasticHeldLast < r.elasticHeldFirst)
+    in.fail("the held-still steps' record is out of range");
   r.lagFrames = in.i32();
   r.maxHandleLag = in.f64();
   r.maxHandleLagFrame = in.i32();

@@ -634,14 +634,23 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
           "the elastic solve failed with self-contact and went on without it at frames " +
           std::to_string(selfContactDropped.first) + "-" +
           std::to_string(selfContactDropped.second) + ": the sheet may pass through itself there");
+    if (report.elasticHeldStill > 0)
+      report.warnings.push_back(
+          "the self-contact guard held the whole sheet still on " +
+          std::to_string(report.elasticHeldStill) + " animation steps at frames " +
+          std::to_string(report.elasticHeldFirst) + "-" + std::to_string(report.elasticHeldLast) +
+          ": not even 1/64 of the elastic step's move kept the crumpling model's mesh from "
+          "passing through itself, and its handles lag there (docs/CRUMPLING.md \"A crossing "
+          "that stops the whole sheet\")");
     for (const auto& h : report.handleLags) {
       if (h.frames == 0) continue;
       char text[400];
       std::snprintf(text, sizeof text,
                     "handle '%s' lags behind its node on %d frames from frame %d, up to %.3g mm "
                     "at frame %d: the sheet cannot follow there without stretching over [model] "
-                    "max_edge_strain",
-                    h.name.c_str(), h.frames, h.firstFrame, 1e3 * h.max, h.maxFrame);
+                    "max_edge_strain%s",
+                    h.name.c_str(), h.frames, h.firstFrame, 1e3 * h.max, h.maxFrame,
+                    report.elasticHeldStill > 0 ? " or passing through itself" : "");
       report.warnings.push_back(text);
     }
     for (const auto& [h, span] : beyondReach) {
@@ -1101,6 +1110,11 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
         report.elasticRetries += stats.elasticRetries;
         report.strainLimitRuns += stats.strainLimitRuns;
         report.strainLimitCarried += stats.strainLimitCarried;
+        if (stats.elasticHeldStill > 0) {
+          report.elasticHeldStill += stats.elasticHeldStill;
+          if (report.elasticHeldFirst < 0) report.elasticHeldFirst = frame;
+          report.elasticHeldLast = frame;
+        }
         if (stats.strainLimit.lag > kLagReported) ++report.lagFrames;
         if (stats.strainLimit.lag > report.maxHandleLag) {
           report.maxHandleLag = stats.strainLimit.lag;
@@ -1434,6 +1448,9 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
     j.key("elastic_retries").value(static_cast<long long>(r.elasticRetries));
     j.key("strain_limit_steps").value(static_cast<long long>(r.strainLimitRuns));
     j.key("strain_limit_carried_steps").value(static_cast<long long>(r.strainLimitCarried));
+    j.key("elastic_steps_held_still").value(static_cast<long long>(r.elasticHeldStill));
+    j.key("elastic_held_first_frame").value(static_cast<long long>(r.elasticHeldFirst));
+    j.key("elastic_held_last_frame").value(static_cast<long long>(r.elasticHeldLast));
     // Handles held back so the sheet does not stretch (strain_limit.hpp).
     j.key("handle_lag_frames").value(static_cast<long long>(r.lagFrames));
     j.key("max_handle_lag").value(r.maxHandleLag);

@@ -39,6 +39,7 @@ void accumulate(HybridStepStats& total, const HybridStepStats& s) {
   total.elastic.newtonRetried += s.elastic.newtonRetried;
   total.elastic.selfContactDropped += s.elastic.selfContactDropped;
   total.elasticRetries += s.elasticRetries;
+  total.elasticHeldStill += s.elasticHeldStill;
   total.undoneByBound += s.undoneByBound;
   GeometricStepStats& g = total.geometric;
   const GeometricStepStats& h = s.geometric;
@@ -396,7 +397,7 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
     stats.elastic = m.elastic->advance(t, dt, pins);
     ++stats.elasticRetries;
   }
-  m.keepElasticStepOutOfItself(elasticStart, dt);
+  if (!(m.keepElasticStepOutOfItself(elasticStart, dt) > 0.0)) ++stats.elasticHeldStill;
   stats.ms.elastic = msSince(t0);
   m.noteHinge(0);
   const std::vector<sim::ContactSample> elasticContacts = m.elastic->contacts();

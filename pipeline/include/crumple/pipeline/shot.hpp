@@ -89,6 +89,10 @@ struct ShotReport {
   // result; frames whose handles lag (over 1 um) and the largest lag.
   long strainLimitRuns = 0;
   long strainLimitCarried = 0;
+  // Animation steps whose elastic step the crossing guard held back entirely
+  // (paper::HybridStepStats::elasticHeldStill), and their first and last frame.
+  long elasticHeldStill = 0;
+  int elasticHeldFirst = -1, elasticHeldLast = -1;
   int lagFrames = 0;
   double maxHandleLag = 0.0;  // metres
   int maxHandleLagFrame = -1;

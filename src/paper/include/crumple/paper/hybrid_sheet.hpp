@@ -44,6 +44,11 @@ struct HybridStepStats {
   int coneSegments = 0;
   bool topologyChanged = false;  // S_P was rebuilt with a new connectivity
   int elasticRetries = 0;        // elastic steps retried with the pins snapped onto their targets
+  // Elastic steps the crossing guard held back entirely: any fraction of
+  // their move would have passed S_P through itself, so the sheet stood
+  // still and its handles lag (docs/CRUMPLING.md "A crossing that stops the
+  // whole sheet").
+  int elasticHeldStill = 0;
   // Geometric steps and remeshings the strain bound undid (docs/CRUMPLING.md
   // "The geometric step under the bound"): their structure changes are in
   // `geometric` all the same.
