@@ -44,8 +44,8 @@ struct HybridStepStats {
   int coneSegments = 0;
   bool topologyChanged = false;  // S_P was rebuilt with a new connectivity
   int elasticRetries = 0;        // elastic steps retried with the pins snapped onto their targets
-  // Elastic steps the crossing guard held back entirely: any fraction of
-  // their move would have passed S_P through itself, so the sheet stood
+  // Elastic steps the crossing guard held back entirely (not even 1/64 of
+  // their move kept S_P from passing through itself), so the sheet stood
   // still and its handles lag (docs/CRUMPLING.md "A crossing that stops the
   // whole sheet").
   int elasticHeldStill = 0;
