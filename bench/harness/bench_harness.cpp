@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <optional>
 #include <set>
@@ -30,10 +31,10 @@ namespace crumple::bench {
 namespace {
 
 // The paper's examples (Tables II, IV, V) on which the two models' Pareto
-// fronts are measured. crumple (Fig. 22) is left out: the plain elastic model
-// cannot run its motion (docs/BENCH.md "What is run"). paper-types shares
-// cylinder-fold's motion, wiggle has no paper figure, tear-cylinder hands a
-// torn sheet over to the elastic model.
+// fronts are measured; crumple (Fig. 22) and crumple-ball have a plan of
+// their own (crumplingShots). paper-types shares cylinder-fold's motion,
+// wiggle has no paper figure, tear-cylinder hands a torn sheet over to the
+// elastic model.
 const std::vector<std::string> kSweepSamples = {"cylinder-fold", "first-singularity", "unload",
                                                 "moebius"};
 // A run longer than this is timed once (its noise is small against its length).
@@ -52,10 +53,11 @@ struct SweepPlan {
   std::vector<int> hybridLengthSweeps;
   std::vector<int> hybridSweepSubsteps;
   std::vector<ElasticMesh> elastic;
+  bool crumplingShots = true;  // their Pareto points and speed reference
 };
 
 SweepPlan sweepPlan(bool quick) {
-  if (quick) return {{1, 2}, {3000}, {1}, {{2.0, {2}, ""}, {1.0, {2}, ""}}};
+  if (quick) return {{1, 2}, {3000}, {1}, {{2.0, {2}, ""}, {1.0, {2}, ""}}, false};
   // The 0.5 cm mesh at one substep needs many halvings (cylinder-fold: 1.5 s per
   // frame); the 0.25 cm mesh stands for the paper's dense FEM of Table II only.
   return {{1, 2, 4, 8},
@@ -64,7 +66,8 @@ SweepPlan sweepPlan(bool quick) {
           {{2.0, {1, 2, 4}, ""},
            {1.0, {1, 2, 4}, ""},
            {0.5, {2, 4}, ""},
-           {0.25, {2}, "first-singularity"}}};
+           {0.25, {2}, "first-singularity"}},
+          true};
 }
 
 std::vector<std::string> allSamples(const fs::path& samplesDir) {
@@ -220,6 +223,23 @@ std::string fileSafe(std::string s) {
 
 }  // namespace
 
+// The crumpling shots, with their speed targets (docs/BENCH.md "The crumpling
+// shots"): on the Pareto fronts like the paper's examples, and timed against
+// the elastic model on a fixed 0.5 cm mesh running the same frames.
+const std::vector<CrumplingTarget>& crumplingShots() {
+  // Chosen to fit the bench's budget (docs/BENCH.md "The crumpling shots"):
+  // the reference's last frame (the 0.5 cm mesh takes 2-30 s per frame on
+  // these motions), and crumple-ball's points (its hybrid model took 5.1 s
+  // per frame at 8 substeps, its 1 cm mesh ran over 15 min without finishing).
+  static const std::vector<CrumplingTarget> shots = {{"crumple", 10.0, 20.0, 36, {2, 8}, {1.0}},
+                                                     {"crumple-ball", 50.0, 20.0, 12, {2}, {2.0}}};
+  return shots;
+}
+const CrumplingTarget* crumplingShot(const std::string& sample) {
+  for (const CrumplingTarget& t : crumplingShots())
+    if (t.sample == sample) return &t;
+  return nullptr;
+}
 std::string BenchRow::label() const {
   char text[64];
   if (model == "hybrid" && lengthSweeps != io::HybridSpec{}.isometryLengthSweeps)
@@ -238,6 +258,53 @@ const std::vector<std::string>& benchStages() {
   return stages;
 }
 
+namespace {
+
+// A crumpling shot's configurations: the hybrid model and the elastic model
+// at the shot's Pareto points over the whole motion, then the speed reference: the elastic model on
+// the fixed 0.5 cm mesh and the hybrid model at its own settings, both over frames
+// 0..referenceLastFrame (role "reference", left out of the fronts).
+void addCrumplingShot(const io::SceneSpec& scene, const BenchRow& own, const CrumplingTarget& shot,
+                      const SweepPlan& plan, int lastFrame,
+                      const std::function<void(const io::SceneSpec&, BenchRow)>& add) {
+  const auto elastic = [&](double edgeCm, const std::string& role) {
+    io::SceneSpec e = scene;
+    e.model.type = io::ModelSpec::Type::Elastic;
+    e.sheet.maxEdge = edgeCm / 100.0;
+    BenchRow row = own;
+    row.role = role;
+    row.model = "elastic";
+    row.edgeCm = edgeCm;
+    row.lengthSweeps = 0;
+    return std::make_pair(e, row);
+  };
+  if (!plan.crumplingShots) return;  // --quick: the shot's own row only
+  for (const int s : shot.hybridSubsteps) {
+    io::SceneSpec h = scene;
+    h.substeps = s;
+    BenchRow row = own;
+    row.role = "sweep";
+    row.substeps = s;
+    add(h, row);
+  }
+  for (const double cm : shot.elasticCm) {
+    auto [e, row] = elastic(cm, "sweep");
+    add(e, row);
+  }
+  int last = scene.frameStart + shot.referenceLastFrame;
+  if (lastFrame >= 0) last = std::min(last, lastFrame);
+  auto [e, row] = elastic(kReferenceEdgeCm, "reference");
+  e.frameEnd = std::min(e.frameEnd, last);
+  add(e, row);
+  io::SceneSpec h = scene;
+  h.frameEnd = std::min(h.frameEnd, last);
+  BenchRow hybridRow = own;
+  hybridRow.role = "reference";
+  add(h, hybridRow);
+}
+
+}  // namespace
+
 std::vector<BenchRow> runBench(const BenchOptions& options, std::ostream& progress) {
   setThreadCount(1);  // ratios compare like with like
   const std::string sourceDir =
@@ -255,7 +322,9 @@ std::vector<BenchRow> runBench(const BenchOptions& options, std::ostream& progre
   std::vector<Config> configs;
   std::set<std::string> planned;
   const auto add = [&](const io::SceneSpec& scene, BenchRow row) {
-    const std::string key = row.sample + "|" + row.label();
+    // A reference runs fewer frames than the row of the same label.
+    const std::string key =
+        row.sample + "|" + row.label() + (row.role == "reference" ? "|reference" : "");
     if (!planned.insert(key).second) return;  // the own settings already hold it
     Config c{scene, std::move(row), 1.0};
     if (lastFrame >= 0) c.scene.frameEnd = std::min(c.scene.frameEnd, lastFrame);
@@ -273,6 +342,10 @@ std::vector<BenchRow> runBench(const BenchOptions& options, std::ostream& progre
     own.substeps = scene.substeps;
     own.lengthSweeps = hybrid ? scene.model.hybrid.isometryLengthSweeps : 0;
     add(scene, own);
+    if (const CrumplingTarget* shot = crumplingShot(name); hybrid && shot) {
+      addCrumplingShot(scene, own, *shot, plan, lastFrame, add);
+      continue;
+    }
     if (!hybrid ||
         std::find(kSweepSamples.begin(), kSweepSamples.end(), name) == kSweepSamples.end())
       continue;

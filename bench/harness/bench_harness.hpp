@@ -27,7 +27,9 @@ struct BenchOptions {
 // time), the error measures from its cache.
 struct BenchRow {
   std::string sample;
-  std::string role;     // "own" (the sample's settings) or "sweep"
+  // "own" (the sample's settings), "sweep", or "reference" (a crumpling
+  // shot's speed reference and its hybrid pair, over the same first frames)
+  std::string role;
   std::string model;    // "hybrid" or "elastic"
   double edgeCm = 0.0;  // the elastic mesh's max edge (0: the hybrid model's adaptive S_P)
   int substeps = 0;
@@ -53,6 +55,27 @@ struct BenchRow {
   // "elastic 0.50 cm x4".
   std::string label() const;
 };
+
+// A crumpling shot's speed targets: the hybrid model at most msPerFrame at
+// its own settings, and at least minSpeedRatio times faster than the elastic
+// model on the fixed kReferenceEdgeCm mesh; that reference runs frames 0 to
+// referenceLastFrame of the shot (the bench's budget), and so does its
+// hybrid pair.
+struct CrumplingTarget {
+  std::string sample;
+  double msPerFrame = 0.0;
+  double minSpeedRatio = 0.0;
+  int referenceLastFrame = 0;
+  // The Pareto points besides the shot's own settings, over the whole motion:
+  // the hybrid model at these substep counts, the elastic model on these
+  // meshes (cm) at the shot's substeps.
+  std::vector<int> hybridSubsteps;
+  std::vector<double> elasticCm;
+};
+inline constexpr double kReferenceEdgeCm = 0.5;
+const std::vector<CrumplingTarget>& crumplingShots();
+// The shot's targets, or nullptr when `sample` is not a crumpling shot.
+const CrumplingTarget* crumplingShot(const std::string& sample);
 
 // The stage columns of bench.csv, in order.
 const std::vector<std::string>& benchStages();

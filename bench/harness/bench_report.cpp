@@ -70,7 +70,7 @@ std::vector<ParetoPoint> points(const std::vector<BenchRow>& rows, const std::st
                                 const std::string& model, const Measure& m) {
   std::vector<ParetoPoint> p;
   for (const BenchRow& r : rows)
-    if (r.sample == sample && r.model == model && r.ok())
+    if (r.sample == sample && r.model == model && r.ok() && r.role != "reference")
       p.push_back({m.scale * m.of(r), r.msTotal, r.label()});
   return p;
 }
@@ -109,6 +109,60 @@ const std::vector<PaperExample>& paperExamples() {
 
 std::string orDash(const BenchRow* r, const std::function<std::string(const BenchRow&)>& f) {
   return r ? f(*r) : std::string("-");
+}
+
+// The crumpling shots against their speed targets (docs/BENCH.md "The
+// crumpling shots").
+void crumplingShotsMarkdown(const std::vector<BenchRow>& rows, std::ostream& md) {
+  bool any = false;
+  for (const CrumplingTarget& t : crumplingShots())
+    any = any || findRow(rows, t.sample, [](const BenchRow& r) { return r.role == "own"; });
+  if (!any) return;
+  md << "## The crumpling shots\n\n"
+     << "crumple and crumple-ball have their own rows on the Pareto fronts above. Their speed "
+     << "targets: the hybrid model at its own settings within the ms per frame below, and at "
+     << "least the given ratio faster than the elastic model on a fixed "
+     << num(kReferenceEdgeCm, "%.2f") << " cm mesh running the same motion. That reference "
+     << "runs the shot's first frames only (the bench's budget), and the hybrid model runs "
+     << "the same frames beside it for the ratio. A reference that stops earlier says where "
+     << "and why in its status. The largest handle error is where a handle lags under the "
+     << "strain bound (`[model] max_edge_strain`): the fronts above weigh lengths and "
+     << "developability, not how far the sheet follows its handles.\n\n"
+     << "| shot | hybrid, own settings: ms/frame (target) | its largest handle error, mm "
+     << "| reference: frames, ms/frame, status | hybrid on the reference's frames: ms/frame "
+     << "| speed ratio (target) |\n"
+     << "| --- | --- | --- | --- | --- | --- |\n";
+  for (const CrumplingTarget& t : crumplingShots()) {
+    const BenchRow* own =
+        findRow(rows, t.sample, [](const BenchRow& r) { return r.role == "own"; });
+    if (!own) continue;
+    const BenchRow* ref = findRow(rows, t.sample, [](const BenchRow& r) {
+      return r.role == "reference" && r.model == "elastic";
+    });
+    const BenchRow* pair = findRow(rows, t.sample, [](const BenchRow& r) {
+      return r.role == "reference" && r.model == "hybrid";
+    });
+    const auto met = [](bool ok) { return ok ? std::string("met") : std::string("not met"); };
+    md << "| " << t.sample << " | " << num(own->msTotal, "%.1f")
+       << " (<= " << num(t.msPerFrame, "%.0f") << ": "
+       << met(own->ok() && own->msTotal <= t.msPerFrame) << ") | "
+       << num(1e3 * own->handleErrorMax, "%.1f") << " | ";
+    if (ref)
+      md << ref->frames << " of the shot's " << own->frames << " frames, "
+         << num(ref->msTotal, "%.0f") << ", " << ref->status;
+    else
+      md << "not run";
+    md << " | " << (pair ? num(pair->msTotal, "%.1f") : std::string("-")) << " | ";
+    if (ref && pair && pair->msTotal > 0.0 && ref->msTotal > 0.0) {
+      const double ratio = ref->msTotal / pair->msTotal;
+      md << num(ratio, "%.1f") << "x (>= " << num(t.minSpeedRatio, "%.0f")
+         << "x: " << met(ratio >= t.minSpeedRatio) << ")";
+    } else {
+      md << "-";
+    }
+    md << " |\n";
+  }
+  md << "\n";
 }
 
 }  // namespace
@@ -272,6 +326,8 @@ std::string benchReportMarkdown(const BenchOptions& options, const std::vector<B
       }
       md << "\n";
     }
+
+  crumplingShotsMarkdown(rows, md);
 
   // Table II: the Sec. 7.1 experiment (Fig. 19) is first-singularity.
   md << "## Paper Table II (Fig. 19)\n\n"

@@ -8,6 +8,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "bench_harness.hpp"
 #include "crumple/exporters/pcache.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "pareto.hpp"
@@ -135,6 +136,51 @@ TEST(BenchAngleDefect, InspectJsonHasTheNewKeys) {
   for (const char* key : {"\"angle_defect_mean\"", "\"angle_defect_max\"", "\"angle_defect_total\"",
                           "\"angle_defect_vertices\"", "\"c_mean\"", "\"handle_error\""})
     EXPECT_NE(r.output.find(key), std::string::npos) << key;
+}
+
+// The crumpling shots' section: the hybrid model's ms per frame against its
+// target, and the speed ratio against the elastic reference on the same
+// frames, which stays off the Pareto fronts.
+TEST(BenchCrumplingShots, TheReportGivesTheTargetsAndTheRatioOnTheReferenceFrames) {
+  const auto row = [](const std::string& role, const std::string& model, double ms, int frames) {
+    bench::BenchRow r;
+    r.sample = "crumple";
+    r.role = role;
+    r.model = model;
+    r.edgeCm = model == "elastic" ? bench::kReferenceEdgeCm : 0.0;
+    r.substeps = 4;
+    r.lengthSweeps = model == "hybrid" ? 300 : 0;
+    r.msTotal = ms;
+    r.frames = frames;
+    r.cMeanMean = model == "hybrid" ? 0.002 : 1e-4;
+    return r;
+  };
+  std::vector<bench::BenchRow> rows = {
+      row("own", "hybrid", 13.0, 109), row("sweep", "elastic", 900.0, 109),
+      row("reference", "elastic", 3000.0, 49), row("reference", "hybrid", 6.0, 49)};
+  rows[0].handleErrorMax = 0.0339;  // a lagging handle
+  rows[1].edgeCm = 1.0;
+  rows[2].status = "stopped: frame 49";
+  rows[2].cMeanMean = 1e-5;  // more accurate than the 1 cm point: on the front were it a point
+  bench::BenchOptions options;
+  options.commandLine = "crumple bench";
+  const std::string md = bench::benchReportMarkdown(options, rows);
+  const std::size_t at = md.find("## The crumpling shots");
+  ASSERT_NE(at, std::string::npos) << md;
+  const std::string section = md.substr(at, md.find("\n## ", at + 1) - at);
+  EXPECT_NE(section.find("| crumple | 13.0 (<= 10: not met) | 33.9 |"), std::string::npos)
+      << section;
+  EXPECT_NE(section.find("49 of the shot's 109 frames, 3000, stopped: frame 49"), std::string::npos)
+      << section;
+  EXPECT_NE(section.find("| 6.0 | 500.0x (>= 20x: met) |"), std::string::npos) << section;
+  // The verdict has one level, the 1 cm elastic point: the reference is not
+  // on the front (and no hybrid point reaches that error).
+  EXPECT_NE(md.find("| crumple | c_mean (mean over frames) | not below | none |"),
+            std::string::npos)
+      << md;
+  const std::size_t fronts = md.find("### crumple, c_mean");
+  ASSERT_NE(fronts, std::string::npos);
+  EXPECT_EQ(md.substr(fronts, at - fronts).find("elastic 0.50 cm"), std::string::npos) << md;
 }
 
 TEST(BenchCommand, QuickWritesTheCsvThePlotAndTheReport) {
