@@ -94,6 +94,36 @@ struct Config {
   double weight = 1.0;  // estimated cost, for the ETA
 };
 
+// The sample (its scene and own row) on the hybrid model at `substeps` and
+// `lengthSweeps` isometry length sweeps (0: the sample's).
+Config hybridAt(const io::SceneSpec& scene, const BenchRow& own, int substeps,
+                const std::string& role, int lengthSweeps = 0) {
+  Config c{scene, own, 1.0};
+  c.scene.substeps = substeps;
+  c.row.role = role;
+  c.row.substeps = substeps;
+  if (lengthSweeps > 0) {
+    c.scene.model.hybrid.isometryLengthSweeps = lengthSweeps;
+    c.row.lengthSweeps = lengthSweeps;
+  }
+  return c;
+}
+
+// The same motion on the elastic model's fixed mesh of `edgeCm`.
+Config elasticAt(const io::SceneSpec& scene, const BenchRow& own, double edgeCm, int substeps,
+                 const std::string& role) {
+  Config c{scene, own, 1.0};
+  c.scene.model.type = io::ModelSpec::Type::Elastic;
+  c.scene.sheet.maxEdge = edgeCm / 100.0;
+  c.scene.substeps = substeps;
+  c.row.role = role;
+  c.row.model = "elastic";
+  c.row.edgeCm = edgeCm;
+  c.row.lengthSweeps = 0;
+  c.row.substeps = substeps;
+  return c;
+}
+
 double meshEdge(const io::SceneSpec& s) {
   return s.sheet.maxEdge > 0.0 ? s.sheet.maxEdge : std::min(s.sheet.width, s.sheet.height) / 16.0;
 }
@@ -261,46 +291,23 @@ const std::vector<std::string>& benchStages() {
 namespace {
 
 // A crumpling shot's configurations: the hybrid model and the elastic model
-// at the shot's Pareto points over the whole motion, then the speed reference: the elastic model on
-// the fixed 0.5 cm mesh and the hybrid model at its own settings, both over frames
-// 0..referenceLastFrame (role "reference", left out of the fronts).
+// at the shot's Pareto points over the whole motion, then the speed
+// reference: the elastic model on the fixed 0.5 cm mesh and the hybrid model
+// at its own settings, both over frames 0..referenceLastFrame (role
+// "reference", left out of the fronts).
 void addCrumplingShot(const io::SceneSpec& scene, const BenchRow& own, const CrumplingTarget& shot,
                       const SweepPlan& plan, int lastFrame,
-                      const std::function<void(const io::SceneSpec&, BenchRow)>& add) {
-  const auto elastic = [&](double edgeCm, const std::string& role) {
-    io::SceneSpec e = scene;
-    e.model.type = io::ModelSpec::Type::Elastic;
-    e.sheet.maxEdge = edgeCm / 100.0;
-    BenchRow row = own;
-    row.role = role;
-    row.model = "elastic";
-    row.edgeCm = edgeCm;
-    row.lengthSweeps = 0;
-    return std::make_pair(e, row);
-  };
+                      const std::function<void(Config)>& add) {
   if (!plan.crumplingShots) return;  // --quick: the shot's own row only
-  for (const int s : shot.hybridSubsteps) {
-    io::SceneSpec h = scene;
-    h.substeps = s;
-    BenchRow row = own;
-    row.role = "sweep";
-    row.substeps = s;
-    add(h, row);
-  }
-  for (const double cm : shot.elasticCm) {
-    auto [e, row] = elastic(cm, "sweep");
-    add(e, row);
-  }
+  for (const int s : shot.hybridSubsteps) add(hybridAt(scene, own, s, "sweep"));
+  for (const double cm : shot.elasticCm) add(elasticAt(scene, own, cm, scene.substeps, "sweep"));
   int last = scene.frameStart + shot.referenceLastFrame;
   if (lastFrame >= 0) last = std::min(last, lastFrame);
-  auto [e, row] = elastic(kReferenceEdgeCm, "reference");
-  e.frameEnd = std::min(e.frameEnd, last);
-  add(e, row);
-  io::SceneSpec h = scene;
-  h.frameEnd = std::min(h.frameEnd, last);
-  BenchRow hybridRow = own;
-  hybridRow.role = "reference";
-  add(h, hybridRow);
+  for (Config c : {elasticAt(scene, own, kReferenceEdgeCm, scene.substeps, "reference"),
+                   hybridAt(scene, own, scene.substeps, "reference")}) {
+    c.scene.frameEnd = std::min(c.scene.frameEnd, last);
+    add(std::move(c));
+  }
 }
 
 }  // namespace
@@ -321,12 +328,11 @@ std::vector<BenchRow> runBench(const BenchOptions& options, std::ostream& progre
   // The plan: each sample at its own settings, then the sweeps.
   std::vector<Config> configs;
   std::set<std::string> planned;
-  const auto add = [&](const io::SceneSpec& scene, BenchRow row) {
+  const auto add = [&](Config c) {
     // A reference runs fewer frames than the row of the same label.
     const std::string key =
-        row.sample + "|" + row.label() + (row.role == "reference" ? "|reference" : "");
+        c.row.sample + "|" + c.row.label() + (c.row.role == "reference" ? "|reference" : "");
     if (!planned.insert(key).second) return;  // the own settings already hold it
-    Config c{scene, std::move(row), 1.0};
     if (lastFrame >= 0) c.scene.frameEnd = std::min(c.scene.frameEnd, lastFrame);
     c.weight = estimateWeight(c.scene);
     configs.push_back(std::move(c));
@@ -341,7 +347,7 @@ std::vector<BenchRow> runBench(const BenchOptions& options, std::ostream& progre
     own.edgeCm = hybrid ? 0.0 : 100.0 * meshEdge(scene);
     own.substeps = scene.substeps;
     own.lengthSweeps = hybrid ? scene.model.hybrid.isometryLengthSweeps : 0;
-    add(scene, own);
+    add(Config{scene, own, 1.0});
     if (const CrumplingTarget* shot = crumplingShot(name); hybrid && shot) {
       addCrumplingShot(scene, own, *shot, plan, lastFrame, add);
       continue;
@@ -349,41 +355,12 @@ std::vector<BenchRow> runBench(const BenchOptions& options, std::ostream& progre
     if (!hybrid ||
         std::find(kSweepSamples.begin(), kSweepSamples.end(), name) == kSweepSamples.end())
       continue;
-    for (const int s : plan.hybridSubsteps) {
-      io::SceneSpec h = scene;
-      h.substeps = s;
-      BenchRow row = own;
-      row.role = "sweep";
-      row.substeps = s;
-      add(h, row);
-    }
+    for (const int s : plan.hybridSubsteps) add(hybridAt(scene, own, s, "sweep"));
     for (const int sweeps : plan.hybridLengthSweeps)
-      for (const int s : plan.hybridSweepSubsteps) {
-        io::SceneSpec h = scene;
-        h.substeps = s;
-        h.model.hybrid.isometryLengthSweeps = sweeps;
-        BenchRow row = own;
-        row.role = "sweep";
-        row.substeps = s;
-        row.lengthSweeps = sweeps;
-        add(h, row);
-      }
-    const auto addElastic = [&](double edgeCm, int substeps) {
-      io::SceneSpec e = scene;
-      e.model.type = io::ModelSpec::Type::Elastic;
-      e.sheet.maxEdge = edgeCm / 100.0;
-      e.substeps = substeps;
-      BenchRow row = own;
-      row.role = "sweep";
-      row.model = "elastic";
-      row.edgeCm = edgeCm;
-      row.lengthSweeps = 0;
-      row.substeps = substeps;
-      add(e, row);
-    };
+      for (const int s : plan.hybridSweepSubsteps) add(hybridAt(scene, own, s, "sweep", sweeps));
     for (const ElasticMesh& mesh : plan.elastic)
       if (mesh.onlySample.empty() || mesh.onlySample == name)
-        for (const int s : mesh.substeps) addElastic(mesh.edgeCm, s);
+        for (const int s : mesh.substeps) add(elasticAt(scene, own, mesh.edgeCm, s, "sweep"));
   }
 
   const fs::path outDir = options.outDir;
