@@ -270,6 +270,7 @@ const CrumplingTarget* crumplingShot(const std::string& sample) {
     if (t.sample == sample) return &t;
   return nullptr;
 }
+
 std::string BenchRow::label() const {
   char text[64];
   if (model == "hybrid" && lengthSweeps != io::HybridSpec{}.isometryLengthSweeps)
