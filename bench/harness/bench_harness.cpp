@@ -284,7 +284,7 @@ std::string BenchRow::label() const {
 
 const std::vector<std::string>& benchStages() {
   static const std::vector<std::string> stages = {
-      "elastic",  "geometric",     "cones", "rebuild",      "isometry",
+      "elastic",  "geometric",     "cones", "rebuild",      "isometry",  "strain limit",
       "contacts", "contact check", "tear",  "sound events", "checkpoint"};
   return stages;
 }

@@ -171,11 +171,10 @@ void writeBenchCsv(const std::string& path, const std::vector<BenchRow>& rows) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write " + path);
   out << "sample,role,model,edge_cm,substeps,length_sweeps,triangles_mean,frames,runs";
-  for (const std::string& s : benchStages())
-    out << ",ms_"
-        << (s == "contact check"  ? "contact_check"
-            : s == "sound events" ? "sound_events"
-                                  : s);
+  for (std::string s : benchStages()) {
+    std::replace(s.begin(), s.end(), ' ', '_');  // "contact check" -> ms_contact_check
+    out << ",ms_" << s;
+  }
   out << ",ms_total,newton_per_substep,c_mean_mean_pct,c_mean_max_pct,n_comp_mean_pct,"
          "n_comp_max_pct,angle_defect_mean_rad,angle_defect_max_rad,angle_defect_total_rad,"
          "handle_error_max_m,popping_max,"

@@ -195,7 +195,7 @@ TEST(BenchCommand, QuickWritesTheCsvThePlotAndTheReport) {
   std::getline(csv, header);
   EXPECT_EQ(header.rfind("sample,role,model,edge_cm,substeps", 0), 0u) << header;
   for (const char* column :
-       {"ms_total", "c_mean_mean_pct", "n_comp_max_pct", "angle_defect_mean_rad",
+       {"ms_total", "ms_strain_limit", "c_mean_mean_pct", "n_comp_max_pct", "angle_defect_mean_rad",
         "angle_defect_max_rad", "handle_error_max_m", "popping_max", "tear_straight_dev_pct",
         "tear_hyperbola_median_deg", "status"})
     EXPECT_NE(header.find(column), std::string::npos) << column;
