@@ -543,9 +543,10 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
           ++stats.singularInserted;
         }
         if ((constrained(bwd) && singular[0] < 0) || (constrained(fwd) && singular[1] < 0)) {
+          // The other side's singular vertex may be in S_G already: undone
+          // with the rest, as a failed remeshing is.
           why << "the strip meets a conical curved region";
-          stats.notes.push_back(why.str());
-          declined[r] = 1;
+          rollback(why.str());
           continue;
         }
         // Rulings fanning from the apex on `side`: aimed where the strip
