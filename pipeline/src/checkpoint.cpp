@@ -17,7 +17,7 @@
 namespace crumple::pipeline {
 namespace {
 
-constexpr std::uint32_t kCheckpointVersion = 4;
+constexpr std::uint32_t kCheckpointVersion = 5;
 constexpr char kMagic[9] = "CRUMPCKP";
 
 std::uint32_t sceneHash(const io::SceneSpec& scene) {

@@ -22,6 +22,17 @@ std::vector<bool> boundaryVertices(const mesh::SheetMesh& sheet) {
   return onBoundary;
 }
 
+// The rotation that best turns the flat offsets onto where the points are
+// now, both in the node's frame (Kabsch 1976), det = +1.
+Mat3 bestTurn(const std::vector<Vec3>& flat, const std::vector<Vec3>& now) {
+  Mat3 cov = Mat3::Zero();
+  for (std::size_t k = 0; k < now.size(); ++k) cov += flat[k] * now[k].transpose();
+  const Eigen::JacobiSVD<Mat3> svd(cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Mat3 fix = Mat3::Identity();
+  fix(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+  return svd.matrixV() * fix * svd.matrixU().transpose();
+}
+
 }  // namespace
 
 std::vector<int> tangentNeighbours(const mesh::SheetMesh& sheet, int vertex, int count) {
@@ -124,7 +135,12 @@ HandleRig::HandleRig(const io::SceneSpec& scene, const io::AnimationScene* anima
       h.releases = true;
       h.releaseTime = *spec.releaseTime;
     }
-    if (spec.tangentControl) {
+    if (spec.tangentControl && spec.patchRadius > 0.0) {
+      h.tangentCount = 0;
+      h.patchRadius = spec.patchRadius;
+      h.bindRotation = pose.rotation;
+      bindPatch(h, sheet, t0);
+    } else if (spec.tangentControl) {
       h.tangentCount = spec.tangentVertices;
       h.tangentVertices = tangentNeighbours(sheet, h.vertex, spec.tangentVertices);
       h.bindRotation = pose.rotation;
@@ -222,7 +238,12 @@ void HandleRig::rebindTangents(const mesh::SheetMesh& sheet, double t) {
     if (h.tangentCount < 0) continue;
     h.tangentVertices.clear();
     h.tangentOffsets.clear();
+    h.patch.clear();
     if (h.releases && t >= h.releaseTime) continue;
+    if (h.patchRadius > 0.0) {
+      bindPatch(h, sheet, t);
+      continue;
+    }
     const Pose pose = animation_->worldPose(h.node, t);
     // Where the tangent vertices are now, in the node's frame, and where the
     // pattern puts them around the handle vertex (in its plane, z = 0).
@@ -241,13 +262,60 @@ void HandleRig::rebindTangents(const mesh::SheetMesh& sheet, double t) {
     // The offsets are the pattern's, rigidly turned to fit where the vertices
     // are (Kabsch): the tangent plane follows the sheet, but the pins never
     // freeze a stretched or compressed neighbourhood into the handle.
-    Mat3 cov = Mat3::Zero();
-    for (std::size_t k = 0; k < now.size(); ++k) cov += flat[k] * now[k].transpose();
-    const Eigen::JacobiSVD<Mat3> svd(cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Mat3 fix = Mat3::Identity();
-    fix(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
-    const Mat3 turn = svd.matrixV() * fix * svd.matrixU().transpose();
+    const Mat3 turn = bestTurn(flat, now);
     for (const Vec3& f : flat) h.tangentOffsets.push_back(turn * f);
+  }
+}
+
+void HandleRig::rebindPatches(const mesh::SheetMesh& sheet, double t) {
+  for (auto& h : handles_) {
+    if (h.patchRadius <= 0.0) continue;
+    h.patch.clear();
+    if (h.releases && t >= h.releaseTime) continue;
+    bindPatch(h, sheet, t);
+  }
+}
+
+// The patch points of h in `sheet`: each one's triangle and weights, and its
+// flat offset from the handle in the pattern turned to fit where the points
+// are now in the node's frame (Kabsch), as the tangent-plane pins are: the
+// patch follows the sheet from one rebinding to the next.
+void HandleRig::bindPatch(BoundHandle& h, const mesh::SheetMesh& sheet, double t) const {
+  h.patch.clear();
+  const Pose pose = animation_->worldPose(h.node, t);
+  const Vec2 centre = sheet.pattern[static_cast<std::size_t>(h.vertex)];
+  std::vector<Vec3> now, flat;
+  constexpr int kDirections = 6;
+  for (int k = 0; k < kDirections; ++k) {
+    const double a = 2.0 * std::numbers::pi * k / kDirections;
+    const Vec2 q = centre + h.patchRadius * Vec2(std::cos(a), std::sin(a));
+    const auto [triangle, w] = mesh::locatePattern(sheet, q);
+    if (triangle < 0) continue;  // beyond the sheet's border
+    const auto& T = sheet.triangles[static_cast<std::size_t>(triangle)];
+    Vec3 x = Vec3::Zero();
+    for (int c = 0; c < 3; ++c)
+      x += w(c) * sheet.positions[static_cast<std::size_t>(T[static_cast<std::size_t>(c)])];
+    now.push_back(pose.rotation.conjugate() * (x - pose.position));
+    flat.emplace_back(q.x() - centre.x(), q.y() - centre.y(), 0.0);
+    h.patch.push_back({triangle, w, Vec3::Zero()});
+  }
+  const Mat3 turn = bestTurn(flat, now);
+  for (std::size_t k = 0; k < flat.size(); ++k) h.patch[k].offset = turn * flat[k];
+}
+
+void HandleRig::grips(double t, double stiffness, std::vector<sim::Grip>& out) const {
+  out.clear();
+  if (std::none_of(handles_.begin(), handles_.end(),
+                   [](const BoundHandle& h) { return !h.patch.empty(); }))
+    return;
+  std::vector<char> held;
+  const std::vector<Vec3> targets = heldTargets(t, held);
+  for (std::size_t i = 0; i < handles_.size(); ++i) {
+    const auto& h = handles_[i];
+    if (!held[i] || h.patch.empty()) continue;
+    const Quat rotation = animation_->worldPose(h.node, t).rotation;
+    for (const auto& p : h.patch)
+      out.push_back({p.triangle, p.weights, targets[i] + rotation * p.offset, stiffness, h.vertex});
   }
 }
 
@@ -265,6 +333,11 @@ void HandleRig::saveState(StateWriter& out) const {
     out.i32s(h.tangentVertices);
     out.vec3s(h.tangentOffsets);
     for (int k = 0; k < 4; ++k) out.f64(h.bindRotation.coeffs()[k]);
+    out.count(h.patch.size());
+    for (const auto& p : h.patch) {
+      out.i32(p.triangle);
+      out.vec3s({p.weights, p.offset});
+    }
   }
 }
 
@@ -278,6 +351,14 @@ void HandleRig::restoreState(StateReader& in) {
     for (int k = 0; k < 4; ++k) h.bindRotation.coeffs()[k] = in.f64();
     if (h.tangentVertices.size() != h.tangentOffsets.size())
       in.fail("a handle's tangent vertices do not match their offsets");
+    h.patch.resize(in.count(4));
+    for (auto& p : h.patch) {
+      p.triangle = in.i32();
+      const std::vector<Vec3> v = in.vec3s();
+      if (p.triangle < 0 || v.size() != 2) in.fail("a handle's patch point is malformed");
+      p.weights = v[0];
+      p.offset = v[1];
+    }
   }
 }
 

@@ -501,6 +501,9 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     rig.pins(t0, start);
     hybrid->placeVertices(start);
     hybrid->setTime(t0);
+    hybrid->setGrips([&rig, k = hybrid->gripStiffness()](double t, std::vector<sim::Grip>& out) {
+      rig.grips(t, k, out);
+    });
     hybrid->setRebuildCallback(
         [&rig](const mesh::SheetMesh& sp, double t) { rig.rebindTangents(sp, t); });
     if (options.projectionProbe) hybrid->setProjectionCallback(options.projectionProbe);
@@ -539,7 +542,14 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   report.selfContactMode = contact.self == sim::SelfContactMode::On    ? "on"
                            : contact.self == sim::SelfContactMode::Off ? "off"
                                                                        : "auto";
+  // Fingers that hold patches ([[handles]] patch_radius) grip as firmly as
+  // the sheet itself: its in-plane stiffness (N/m).
+  const auto holdGrips = [&rig, k = materialOf(scene.paper).stretchStiffness() *
+                                    params.membraneScale](sim::ElasticSheet& model) {
+    model.setGrips([&rig, k](double t, std::vector<sim::Grip>& out) { rig.grips(t, k, out); });
+  };
   if (elastic) elastic->setContacts(contact);
+  if (elastic) holdGrips(*elastic);
   if (hybrid) hybrid->setContacts(contact);
   // Tearing (issue 6): runs only when the scene enables it.
   std::optional<tear::Tearing> tearing;
@@ -953,6 +963,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
         carriedContacts.reset();  // S_P's vertices: the next frame's contacts are the fine mesh's
         elastic.emplace(sheet, materialOf(scene.paper), params);
         elastic->setContacts(contact);
+        holdGrips(*elastic);
         // Interpolating S_P's long thin cells does not keep the fine mesh's
         // edge lengths: it settles first, with its pins where they are, in
         // a few tiny implicit steps (kRelaxSteps of kRelaxDt), then takes
@@ -984,6 +995,8 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
         sim::ElasticSheet next(sheet, materialOf(scene.paper), params);
         next.setVelocities(velocities);
         next.setContacts(contact);
+        rig.rebindPatches(sheet, frameTime(scene, frame));
+        holdGrips(next);
         for (std::size_t h = 0; h < next.hinges().size(); ++h) {
           const auto it = hingeState.find({next.hinges()[h].v[0], next.hinges()[h].v[1]});
           if (it == hingeState.end()) continue;
@@ -1067,6 +1080,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
       sheet = mesh::restoreSheetMesh(in);
       elastic.emplace(sheet, materialOf(scene.paper), params);
       elastic->setContacts(contact);
+      holdGrips(*elastic);
       elastic->restoreState(in);
       sheet.positions = elastic->positions();
       record.singularVertices = in.i32s();

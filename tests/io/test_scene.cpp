@@ -369,6 +369,15 @@ TEST(SceneErrors, SheetShape) {
 
 const std::string kAnimSheet = "[scene]\nanimation = \"anim.gltf\"\n" + kSheet;  // lines 1-5
 
+TEST(Scene, APatchRadiusIsInTheScenesUnits) {
+  const SceneSpec s = parse("[scene]\nunits = \"cm\"\nanimation = \"anim.gltf\"\n" + kSheet +
+                            "[[handles]]\nnode = \"Handle\"\ntangent_control = true\n"
+                            "patch_radius = 0.5\n[[handles]]\nnode = \"Child\"\n");
+  ASSERT_EQ(s.handles.size(), 2u);
+  EXPECT_NEAR(s.handles[0].patchRadius, 0.005, 1e-15);
+  EXPECT_EQ(s.handles[1].patchRadius, 0.0) << "tangent-plane vertices unless asked";
+}
+
 TEST(SceneErrors, Handles) {
   expectError(kAnimSheet +
                   "[[handles]]\nnode = \"Handle\"\ntangent_control = true\n"
@@ -380,6 +389,18 @@ TEST(SceneErrors, Handles) {
               9, "handles[0].tangent_vertices");
   expectError(kAnimSheet + "[[handles]]\nnode = \"Handle\"\ntangent_vertices = 3\n", 8,
               "handles[0].tangent_vertices", {"needs tangent_control = true"});
+  expectError(kAnimSheet + "[[handles]]\nnode = \"Handle\"\npatch_radius = 0.5\n", 8,
+              "handles[0].patch_radius", {"needs tangent_control = true"});
+  expectError(kAnimSheet +
+                  "[[handles]]\nnode = \"Handle\"\ntangent_control = true\n"
+                  "tangent_vertices = 3\npatch_radius = 0.5\n",
+              10, "handles[0].patch_radius", {"not both"});
+  expectError(
+      kAnimSheet + "[[handles]]\nnode = \"Handle\"\ntangent_control = true\npatch_radius = 0\n", 9,
+      "handles[0].patch_radius", {"above 0", "5.25"});
+  expectError(
+      kAnimSheet + "[[handles]]\nnode = \"Handle\"\ntangent_control = true\npatch_radius = 6\n", 9,
+      "handles[0].patch_radius", {"a quarter of the sheet's side"});
   expectError(kAnimSheet + "[[handles]]\nnode = \"Handle\"\n[[handles]]\nnode = \"Handle\"\n", 9,
               "handles[1].node", {"duplicate handle name 'Handle'"});
   expectError(kAnimSheet +

@@ -117,3 +117,23 @@ TEST(PolygonSheet, AnLShapeIsCoveredExactlyWithEveryOutlinePointAVertex) {
 
 }  // namespace
 }  // namespace crumple::mesh
+
+// locatePattern: a point inside the pattern is the weighted sum of its
+// triangle's corners (weights >= 0, summing to 1); a point on the border is
+// inside; a point beyond it is in no triangle.
+TEST(LocatePattern, GivesTheTriangleAndWeightsOfAPatternPoint) {
+  const SheetMesh m = makeRectangleSheet(0.1, 0.05, 0.02);
+  for (const Vec2& p :
+       {Vec2(0.013, 0.027), Vec2(0.0999, 0.0001), Vec2(0.05, 0.0), Vec2(0.0, 0.05)}) {
+    const PatternLocation at = locatePattern(m, p);
+    ASSERT_GE(at.triangle, 0) << p.transpose();
+    const auto& t = m.triangles[static_cast<std::size_t>(at.triangle)];
+    Vec2 q = Vec2::Zero();
+    for (int c = 0; c < 3; ++c) q += at.weights(c) * m.pattern[static_cast<std::size_t>(t[c])];
+    EXPECT_LT((q - p).norm(), 1e-15) << p.transpose();
+    EXPECT_NEAR(at.weights.sum(), 1.0, 1e-12);
+    EXPECT_GE(at.weights.minCoeff(), -1e-12);
+  }
+  EXPECT_EQ(locatePattern(m, Vec2(0.101, 0.02)).triangle, -1);
+  EXPECT_EQ(locatePattern(m, Vec2(0.05, -1e-6)).triangle, -1);
+}

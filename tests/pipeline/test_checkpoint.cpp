@@ -154,3 +154,10 @@ TEST(Checkpoint, ResumeRefusesWhatItCannotContinue) {
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.output.find("damaged"), std::string::npos) << r.output;
 }
+
+// Fingers that hold patches (their patch points, rebound on every rebuild
+// of S_P and after each cut): tear-cylinder's patches variant tears at
+// frame 44, so the kill falls before or after it.
+TEST(Checkpoint, FingersHoldingPatchesResumeToTheSameBytes) {
+  killAndResume("samples/tear-cylinder/patches.toml", 48, 1, 3);
+}

@@ -150,3 +150,61 @@ TEST(HandleRig, AVertexInNoTriangleHasNoTangentNeighbours) {
   EXPECT_TRUE(pipeline::tangentNeighbours(sheet, 3, 0).empty());
   EXPECT_EQ(pipeline::tangentNeighbours(sheet, 0, 0).size(), 2u) << "a corner: 2";
 }
+
+// A finger that holds a patch ([[handles]] patch_radius) pins only its
+// vertex; its six patch points (an interior handle) are grips at the patch
+// radius around it in the pattern, drawn to where the node's motion and
+// rotation carry them: at a later time the grip targets are the bind-time
+// points turned by the node's rotation since then, about the moving node.
+TEST(HandleRig, APatchPinsTheHandleAndGripsSixPointsThatTurnWithTheNode) {
+  RigFixture f;
+  f.spec.handles[0].patchRadius = 0.005;
+  f.place(f.anim.worldPose("A", 0.0).position, Mat3::Identity());
+  pipeline::HandleRig rig(f.spec, &f.anim, f.sheet, 0.0);
+  std::vector<sim::Pin> pins;
+  rig.pins(0.0, pins);
+  ASSERT_EQ(pins.size(), 1u) << "the patch replaces the tangent-plane vertices";
+  EXPECT_EQ(pins[0].vertex, f.handleVertex);
+  std::vector<sim::Grip> grips;
+  constexpr double kStiffness = 1234.0;
+  rig.grips(0.0, kStiffness, grips);
+  ASSERT_EQ(grips.size(), 6u) << "an interior handle's patch has all six directions";
+  const Vec3 centre = f.sheet.positions[static_cast<std::size_t>(f.handleVertex)];
+  for (const sim::Grip& g : grips) {
+    EXPECT_EQ(g.anchor, f.handleVertex);
+    EXPECT_EQ(g.stiffness, kStiffness);
+    EXPECT_NEAR(g.weights.sum(), 1.0, 1e-12);
+    EXPECT_GE(g.weights.minCoeff(), -1e-12);
+    // At bind time each grip is where its point of the sheet is: at the
+    // patch radius from the handle.
+    const auto& T = f.sheet.triangles[static_cast<std::size_t>(g.triangle)];
+    Vec3 x = Vec3::Zero();
+    for (int c = 0; c < 3; ++c)
+      x += g.weights(c) * f.sheet.positions[static_cast<std::size_t>(T[c])];
+    EXPECT_LT((g.position - x).norm(), 1e-12);
+    EXPECT_NEAR((g.position - centre).norm(), 0.005, 1e-12);
+  }
+  const double t = 0.7;
+  std::vector<sim::Grip> later;
+  rig.grips(t, kStiffness, later);
+  ASSERT_EQ(later.size(), grips.size());
+  const Quat turn =
+      f.anim.worldPose("A", t).rotation * f.anim.worldPose("A", 0.0).rotation.conjugate();
+  for (std::size_t k = 0; k < later.size(); ++k)
+    EXPECT_LT((later[k].position - (rig.target(0, t) + turn * (grips[k].position - centre))).norm(),
+              1e-12);
+  // A corner's patch keeps the directions inside the sheet: 0 and 60 degrees.
+  RigFixture corner;
+  corner.spec.handles[0].patternPoint = Vec2(0.0, 0.0);
+  corner.spec.handles[0].patchRadius = 0.005;
+  corner.place(corner.anim.worldPose("A", 0.0).position, Mat3::Identity());
+  pipeline::HandleRig cornerRig(corner.spec, &corner.anim, corner.sheet, 0.0);
+  cornerRig.grips(0.0, kStiffness, grips);
+  EXPECT_EQ(grips.size(), 2u);
+  // Without a patch radius there are no grips.
+  RigFixture pinned;
+  pinned.place(pinned.anim.worldPose("A", 0.0).position, Mat3::Identity());
+  pipeline::HandleRig pinnedRig(pinned.spec, &pinned.anim, pinned.sheet, 0.0);
+  pinnedRig.grips(0.0, kStiffness, grips);
+  EXPECT_TRUE(grips.empty());
+}

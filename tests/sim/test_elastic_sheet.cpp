@@ -175,6 +175,43 @@ TEST(ElasticSheet, PinsFollowAMovingTargetExactly) {
   EXPECT_EQ(sheet.analyzeCount(), 1);
 }
 
+// A grip holds a point inside a triangle, not a vertex: with the top corners
+// pinned, a grip drawing the sheet's centre 3 cm out of its plane brings the
+// gripped point there within the spring's give, and nothing is pinned there.
+TEST(ElasticSheet, AGripDrawsAPointOfATriangleToItsTarget) {
+  mesh::SheetMesh m = a4Sheet(0.0, 0.05);
+  ElasticSheet sheet(m, officePaper(), SimParams{});
+  // The triangle holding the pattern point (0.1, 0.15) and its weights.
+  const auto [tri, w] = mesh::locatePattern(m, Vec2(0.1, 0.15));
+  ASSERT_GE(tri, 0);
+  const auto& T = m.triangles[static_cast<std::size_t>(tri)];
+  const auto point = [&](const std::vector<Vec3>& x) {
+    return Vec3(w(0) * x[static_cast<std::size_t>(T[0])] +
+                w(1) * x[static_cast<std::size_t>(T[1])] +
+                w(2) * x[static_cast<std::size_t>(T[2])]);
+  };
+  const Vec3 target = point(m.positions) + Vec3(0.0, 0.0, 0.03);
+  constexpr double kStiffness = 200.0;  // N/m
+  sheet.setGrips([&](double, std::vector<Grip>& out) {
+    out.push_back({tri, w, target, kStiffness, -1});
+  });
+  runToRest(sheet, topCorners(m), 1.0 / 48.0, 200, 1e-7);
+  // The spring's give: the weight of the sheet below it and its bending,
+  // a few millimetres at most.
+  const double miss = (point(sheet.positions()) - target).norm();
+  EXPECT_LT(miss, 0.004);
+  // Without the grip the point hangs in its plane.
+  ElasticSheet free(m, officePaper(), SimParams{});
+  runToRest(free, topCorners(m), 1.0 / 48.0, 200, 1e-7);
+  EXPECT_LT(std::abs(point(free.positions()).z()), 1e-4);
+  EXPECT_GT(point(sheet.positions()).z(), 0.025);
+  // A grip on a missing triangle is a programming error.
+  sheet.setGrips([&](double, std::vector<Grip>& out) {
+    out.push_back({static_cast<int>(m.triangles.size()), w, target, kStiffness, -1});
+  });
+  EXPECT_THROW(sheet.advance(0.0, 0.01, topCorners(m)), std::out_of_range);
+}
+
 TEST(ElasticSheet, HopelessStepThrowsAndRestoresState) {
   const mesh::SheetMesh m = a4Sheet(0.3, 0.03);
   const PinFunction good = topCorners(m);

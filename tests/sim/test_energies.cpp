@@ -188,6 +188,38 @@ TEST(MembraneEnergy, GradientAndHessianMatchFiniteDifferences) {
   RecordProperty("worst_hessian_relative_error", sci(worstHessian));
 }
 
+TEST(GripEnergy, GradientAndHessianMatchFiniteDifferences) {
+  Random r(11);
+  for (int trial = 0; trial < 8; ++trial) {
+    Vec9 x;
+    for (int a = 0; a < 3; ++a) x.segment<3>(3 * a) = r.vec3(0.02);
+    const double w0 = r.uniform(0.0, 1.0), w1 = r.uniform(0.0, 1.0 - w0);
+    const Vec3 w(w0, w1, 1.0 - w0 - w1);
+    const Vec3 target = r.vec3(0.02);
+    const double k = r.uniform(10.0, 1e4);
+    auto energy = [&](const Vec9& y) {
+      return gripEnergy(y.segment<3>(0), y.segment<3>(3), y.segment<3>(6), w, target, k);
+    };
+    auto gradient = [&](const Vec9& y) {
+      Vec9 g;
+      gripEnergy(y.segment<3>(0), y.segment<3>(3), y.segment<3>(6), w, target, k, &g);
+      return g;
+    };
+    Vec9 g;
+    const double e =
+        gripEnergy(x.segment<3>(0), x.segment<3>(3), x.segment<3>(6), w, target, k, &g);
+    const Vec3 point = w(0) * x.segment<3>(0) + w(1) * x.segment<3>(3) + w(2) * x.segment<3>(6);
+    EXPECT_NEAR(e, 0.5 * k * (point - target).squaredNorm(), 1e-12 * std::max(1.0, e));
+    const double eps = 1e-7;
+    EXPECT_LT(relativeError(g, fdGradient<9>(energy, x, eps), 1e-12), kTolerance) << trial;
+    // The Hessian ElasticSheet assembles: k (w w^T) (x) I_3.
+    Mat9 h = Mat9::Zero();
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) h.block<3, 3>(3 * a, 3 * b) = k * w(a) * w(b) * Mat3::Identity();
+    EXPECT_LT(relativeError(h, fdHessian<9>(gradient, x, eps), 1e-12), kTolerance) << trial;
+  }
+}
+
 TEST(DihedralAngle, SignConventionAndRange) {
   // A = (x0, x1, x2) counter-clockwise about +z. Lifting x3 towards +z
   // (the normal side) makes a valley seen from the normals: theta < 0.

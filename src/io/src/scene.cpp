@@ -358,8 +358,8 @@ class SceneParser {
     for (std::size_t i = 0; i < handles->size(); ++i) {
       const TableReader r(*handles->get(i)->as_table(), "handles[" + std::to_string(i) + "]",
                           file_);
-      r.allowOnly(
-          {"name", "node", "pattern", "tangent_control", "tangent_vertices", "release_time"});
+      r.allowOnly({"name", "node", "pattern", "tangent_control", "tangent_vertices", "patch_radius",
+                   "release_time"});
       HandleSpec h;
       const std::optional<std::string> node = r.string("node");
       if (!node) r.missing("node");
@@ -398,6 +398,18 @@ class SceneParser {
           r.fail("tangent_vertices", "needs tangent_control = true");
         }
         h.tangentVertices = static_cast<int>(*n);
+      }
+      if (auto radius = r.number("patch_radius")) {
+        if (!h.tangentControl) r.fail("patch_radius", "needs tangent_control = true");
+        if (h.tangentVertices != 0)
+          r.fail("patch_radius", "a handle holds a patch or tangent_vertices, not both");
+        const SheetSpec& s = spec_.sheet;
+        const double most = 0.25 * std::min(s.width, s.height);
+        if (!(*radius > 0.0) || !(*radius * mpu() <= most))
+          r.fail("patch_radius", "must be above 0 and at most a quarter of the sheet's side (" +
+                                     formatNumber(most / mpu()) + "; got " + formatNumber(*radius) +
+                                     ")");
+        h.patchRadius = *radius * mpu();
       }
       if (auto t = r.number("release_time")) {
         h.releaseTime = r.requireNonNegative("release_time", *t);

@@ -97,6 +97,22 @@ int nearestPatternVertex(const SheetMesh& mesh, const Vec2& p) {
   return best;
 }
 
+PatternLocation locatePattern(const SheetMesh& mesh, const Vec2& p) {
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& T = mesh.triangles[t];
+    const Vec2 a = mesh.pattern[static_cast<std::size_t>(T[0])];
+    Mat2 d;
+    d << mesh.pattern[static_cast<std::size_t>(T[1])] - a,
+        mesh.pattern[static_cast<std::size_t>(T[2])] - a;
+    if (!(std::abs(d.determinant()) > 0.0)) continue;
+    const Vec2 l = d.inverse() * (p - a);
+    constexpr double kOnBorder = 1e-12;  // relative: p on an edge is inside
+    if (l(0) >= -kOnBorder && l(1) >= -kOnBorder && l(0) + l(1) <= 1.0 + kOnBorder)
+      return {static_cast<int>(t), Vec3(1.0 - l(0) - l(1), l(0), l(1))};
+  }
+  return {};
+}
+
 int nearestVertex(const SheetMesh& mesh, const Vec3& p) {
   int best = -1;
   double bestD = std::numeric_limits<double>::infinity();

@@ -137,6 +137,12 @@ HybridSheet::~HybridSheet() = default;
 HybridSheet::HybridSheet(HybridSheet&&) noexcept = default;
 HybridSheet& HybridSheet::operator=(HybridSheet&&) noexcept = default;
 
+void HybridSheet::setGrips(sim::GripFunction grips) { impl_->grips = std::move(grips); }
+
+double HybridSheet::gripStiffness() const {
+  return impl_->material.stretchStiffness() * impl_->simParams.membraneScale;
+}
+
 void HybridSheet::setRebuildCallback(
     std::function<void(const mesh::SheetMesh&, double t)> callback) {
   impl_->onRebuild = std::move(callback);
@@ -383,6 +389,7 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
   auto t0 = Clock::now();
   const std::vector<Vec3> elasticStart =
       m.crossingGuard() > 0.0 ? m.elastic->positions() : std::vector<Vec3>{};
+  m.elastic->setGrips(m.laggingGrips(pins, nodePins));
   try {
     stats.elastic = m.elastic->advance(t, dt, pins);
   } catch (const NumericalError&) {

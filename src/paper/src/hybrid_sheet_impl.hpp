@@ -52,6 +52,7 @@ struct HybridSheet::Impl {
   std::vector<Vec3> spVelocities;
   double paperLength = 0.0;
   std::function<void(const mesh::SheetMesh&, double)> onRebuild;
+  sim::GripFunction grips;  // fingers as contact patches (setGrips)
   std::function<void(const ProjectionInput&)> onProjection;  // paper Table III inputs
   // The isometry projection's options from the parameters (paper Sec. 6.3).
   IsometryOptions isometryOptions() const {
@@ -156,6 +157,10 @@ struct HybridSheet::Impl {
   // brought on at most params.lagCatchUpSpeed faster than its node, its
   // tangent-plane pins moved with it.
   sim::PinFunction catchUpPins(double t, double dt, const sim::PinFunction& pins) const;
+  // The grips of an animation step, each moved by how far catchUpPins puts
+  // its anchor handle from the handle's node (`pins` against `nodePins`).
+  sim::GripFunction laggingGrips(const sim::PinFunction& pins,
+                                 const sim::PinFunction& nodePins) const;
   // stats.lag and handleLags of x against the handles' nodes (the pins of
   // the rig, not catchUpPins').
   void measureLags(const std::vector<sim::Pin>& nodes, const std::vector<Vec3>& x,

@@ -117,6 +117,25 @@ double HybridSheet::Impl::keepElasticStepOutOfItself(const std::vector<Vec3>& x0
 // from it. Without this the first step whose structure lets the sheet follow
 // again closes the whole lag at once, and the sheet jumps (docs/CRUMPLING.md
 // "Popping").
+sim::GripFunction HybridSheet::Impl::laggingGrips(const sim::PinFunction& pins,
+                                                  const sim::PinFunction& nodePins) const {
+  if (!grips) return {};
+  return [this, pins, nodePins](double t, std::vector<sim::Grip>& out) {
+    grips(t, out);
+    std::vector<sim::Pin> now, nodes;
+    pins(t, now);
+    nodePins(t, nodes);
+    for (sim::Grip& g : out) {
+      const auto at = [&](const std::vector<sim::Pin>& list) {
+        return std::find_if(list.begin(), list.end(),
+                            [&](const sim::Pin& p) { return p.vertex == g.anchor; });
+      };
+      const auto a = at(now), b = at(nodes);
+      if (a != now.end() && b != nodes.end()) g.position += a->position - b->position;
+    }
+  };
+}
+
 sim::PinFunction HybridSheet::Impl::catchUpPins(double t, double dt,
                                                 const sim::PinFunction& pins) const {
   const double speed = params.lagCatchUpSpeed;

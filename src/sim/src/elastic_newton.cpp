@@ -34,6 +34,32 @@ bool ElasticSheet::Impl::collectPins(double t1, const PinFunction& pins, std::st
   return true;
 }
 
+bool ElasticSheet::Impl::collectGrips(double t1, std::string& why) {
+  gripBuffer.clear();
+  if (grips) grips(t1, gripBuffer);
+  for (const Grip& g : gripBuffer) {
+    if (g.triangle < 0 || static_cast<std::size_t>(g.triangle) >= triangles.size())
+      throw std::out_of_range("ElasticSheet: grip on triangle " + std::to_string(g.triangle) +
+                              " (mesh has " + std::to_string(triangles.size()) + ")");
+    if (!g.position.allFinite() || !g.weights.allFinite() || !std::isfinite(g.stiffness) ||
+        g.stiffness < 0.0) {
+      why = "non-finite or negative grip on triangle " + std::to_string(g.triangle);
+      return false;
+    }
+  }
+  return true;
+}
+
+double ElasticSheet::Impl::gripEnergy(const std::vector<Vec3>& xs) const {
+  double e = 0.0;
+  for (const Grip& g : gripBuffer) {
+    const auto& t = triangles[static_cast<std::size_t>(g.triangle)];
+    e += sim::gripEnergy(xs[static_cast<std::size_t>(t[0])], xs[static_cast<std::size_t>(t[1])],
+                         xs[static_cast<std::size_t>(t[2])], g.weights, g.position, g.stiffness);
+  }
+  return e;
+}
+
 void ElasticSheet::Impl::startNewton(NewtonState& s) {
   const double h = s.h;
   const std::size_t nv = vertexCount;
@@ -153,6 +179,17 @@ bool ElasticSheet::Impl::newtonGradient(NewtonState& s, std::string& why) {
       if (fi >= 0) s.gradV.segment<3>(3 * fi) -= fc.k * gap * fc.w[a] * fc.normal;
     }
   }
+  for (const Grip& grip : gripBuffer) {
+    const auto& tri = triangles[static_cast<std::size_t>(grip.triangle)];
+    Vec9 g;
+    sim::gripEnergy(xk[static_cast<std::size_t>(tri[0])], xk[static_cast<std::size_t>(tri[1])],
+                    xk[static_cast<std::size_t>(tri[2])], grip.weights, grip.position,
+                    grip.stiffness, &g);
+    for (std::size_t a = 0; a < 3; ++a) {
+      const int fi = freeIndex[static_cast<std::size_t>(tri[a])];
+      if (fi >= 0) s.gradV.segment<3>(3 * fi) += g.segment<3>(3 * static_cast<int>(a));
+    }
+  }
   s.grad = s.gradQ + s.gradV;
   if (!s.grad.allFinite()) {
     why = "non-finite forces";
@@ -200,6 +237,16 @@ bool ElasticSheet::Impl::assembleSystem(const NewtonState& s) {
     const int* off = triOffset.data() + 81 * fc.triangle;
     for (int i = 0; i < 81; ++i)
       if (off[i] >= 0) values[off[i]] += block.data()[i];
+  }
+  for (const Grip& grip : gripBuffer) {
+    // k (w w^T) (x) I_3: constant, positive semi-definite.
+    const int* off = triOffset.data() + 81 * grip.triangle;
+    for (int b = 0; b < 3; ++b)
+      for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 3; ++c) {
+          const int i = (3 * b + c) * 9 + (3 * a + c);  // column-major (row 3a+c, column 3b+c)
+          if (off[i] >= 0) values[off[i]] += grip.stiffness * grip.weights(a) * grip.weights(b);
+        }
   }
   return Eigen::Map<const VecX>(values, matrix.nonZeros()).allFinite();
 }
@@ -271,7 +318,7 @@ ElasticSheet::Impl::LineSearchResult ElasticSheet::Impl::lineSearch(NewtonState&
     curvature += kd.dot(s.dx);
   }
   const double slopeQ = s.gradQ.dot(s.dx);
-  const double contactNow = contactEnergy(s.xk, s.frictionEps);
+  const double contactNow = contactEnergy(s.xk, s.frictionEps) + gripEnergy(s.xk);
   step = 1.0;
   for (int ls = 0; ls <= kMaxLineSearchHalvings; ++ls, step *= 0.5) {
     applyStep(s, step);
@@ -279,8 +326,8 @@ ElasticSheet::Impl::LineSearchResult ElasticSheet::Impl::lineSearch(NewtonState&
     double deltaV = 0.0;
     for (std::size_t i = 0; i < triangles.size(); ++i) deltaV += triTrial[i] - triEnergy[i];
     for (std::size_t k = 0; k < hinges.size(); ++k) deltaV += hingeTrial[k] - hingeEnergy[k];
-    if (!contactPlanes.empty() || !faceContacts.empty())
-      deltaV += contactEnergy(s.xTrial, s.frictionEps) - contactNow;
+    if (!contactPlanes.empty() || !faceContacts.empty() || !gripBuffer.empty())
+      deltaV += contactEnergy(s.xTrial, s.frictionEps) + gripEnergy(s.xTrial) - contactNow;
     const double deltaPhi = step * slopeQ + 0.5 * step * step * curvature + deltaV;
     if (std::isfinite(deltaPhi) && deltaPhi <= kArmijo * step * slope)
       return LineSearchResult::Accepted;
@@ -339,7 +386,7 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
     contact.moveColliders(t0);
     contact.moveColliders(t1);
   }
-  if (!collectPins(t1, pins, why)) return false;
+  if (!collectPins(t1, pins, why) || !collectGrips(t1, why)) return false;
   NewtonState s;
   s.h = t1 - t0;
   startNewton(s);
@@ -399,6 +446,8 @@ bool ElasticSheet::Impl::stepRecursive(double t0, double t1, const PinFunction& 
   if (!stepRecursive(t0, mid, pins, depth + 1, stats, why)) return false;
   return stepRecursive(mid, t1, pins, depth + 1, stats, why);
 }
+
+void ElasticSheet::setGrips(GripFunction grips) { impl_->grips = std::move(grips); }
 
 StepStats ElasticSheet::advance(double t, double dt, const PinFunction& pins) {
   if (!(dt > 0.0) || !std::isfinite(dt) || !std::isfinite(t))

@@ -259,6 +259,8 @@ struct ElasticSheet::Impl {
   // ---- step scratch ----
   std::vector<Pin> pinBuffer;
   std::vector<int> pinTarget;  // vertex -> index into pinBuffer, -1 if free
+  GripFunction grips;
+  std::vector<Grip> gripBuffer;  // the grips at the substep's end time
 
   Impl(const mesh::SheetMesh& m, const Material& material, const SimParams& p);
   bool buildSystem(const std::vector<int>& pinned);
@@ -280,6 +282,10 @@ struct ElasticSheet::Impl {
   // Reads the pins at t1 into pinBuffer / pinTarget and (re)builds the
   // system when the pinned set changed. False with `why` on bad input.
   bool collectPins(double t1, const PinFunction& pins, std::string& why);
+  // Reads the grips at t1 into gripBuffer. False with `why` on bad values.
+  bool collectGrips(double t1, std::string& why);
+  // Energy of the grips at xs (gripEnergy).
+  double gripEnergy(const std::vector<Vec3>& xs) const;
   // x~ = x_n + h v_n + h^2 g, the predictor as the first iterate, and the
   // stiffness damping frozen at x_n.
   void startNewton(NewtonState& s);

@@ -256,6 +256,14 @@ double bendingEnergy(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3&
   return stiffness * d * d;
 }
 
+double gripEnergy(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& weights,
+                  const Vec3& target, double stiffness, Vec9* gradient) {
+  const Vec3 r = weights(0) * x0 + weights(1) * x1 + weights(2) * x2 - target;
+  if (gradient != nullptr)
+    for (int a = 0; a < 3; ++a) gradient->segment<3>(3 * a) = stiffness * weights(a) * r;
+  return 0.5 * stiffness * r.squaredNorm();
+}
+
 bool projectToPsd(Mat9& m) { return projectToPsdImpl<9>(m); }
 bool projectToPsd(Mat12& m) { return projectToPsdImpl<12>(m); }
 bool projectTranslationInvariantToPsd(Mat9& m) { return projectTranslationInvariantImpl<3>(m); }

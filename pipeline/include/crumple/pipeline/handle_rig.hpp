@@ -23,6 +23,16 @@ struct BoundHandle {
   // handle vertex in the node's frame at bind time.
   std::vector<int> tangentVertices;
   std::vector<Vec3> tangentOffsets;
+  // A finger's contact patch ([[handles]] patch_radius): points of the
+  // sheet at patchRadius (m) around the handle, each inside a triangle, and
+  // their offsets from the handle in the node's frame. 0: tangent vertices.
+  double patchRadius = 0.0;
+  struct PatchPoint {
+    int triangle = -1;
+    Vec3 weights = Vec3::Zero();
+    Vec3 offset = Vec3::Zero();
+  };
+  std::vector<PatchPoint> patch;
   Quat bindRotation = Quat::Identity();
   double releaseTime = 0.0;
   bool releases = false;
@@ -69,6 +79,16 @@ class HandleRig {
   // vertex handleVertices[h] of `sheet` from now on, and the tangent-plane
   // vertices are chosen again as by rebindTangents.
   void rebind(const mesh::SheetMesh& sheet, const std::vector<int>& handleVertices, double t);
+  // Fingers as contact patches: a handle with a patch radius pins only its
+  // vertex, and holds the points of the sheet at that radius around its
+  // pattern point (six directions, those inside the pattern) as grips
+  // (sim::Grip) that turn with its node. Their grips at time t, each drawn
+  // with `stiffness` (N/m) to where the handle's target and node rotation
+  // put it, anchored on the handle's vertex.
+  void grips(double t, double stiffness, std::vector<sim::Grip>& out) const;
+  // The patches bound again on a mesh whose triangles changed (a cut) at
+  // time t; the tangent-plane vertices stay.
+  void rebindPatches(const mesh::SheetMesh& sheet, double t);
   // Moves pinned vertices onto their targets (called once before simulation).
   void snap(double t, std::vector<Vec3>& positions) const;
   // Checkpoint and resume (issue 8): each handle's vertex, tangent-plane
@@ -81,6 +101,8 @@ class HandleRig {
   // The held handles' positions at time t, limited to the sheet's reach;
   // `held` says which handles hold at t.
   std::vector<Vec3> heldTargets(double t, std::vector<char>& held) const;
+  // Binds h's patch on `sheet` at time t (holdPatches).
+  void bindPatch(BoundHandle& h, const mesh::SheetMesh& sheet, double t) const;
 
   const io::AnimationScene* animation_;
   std::vector<BoundHandle> handles_;

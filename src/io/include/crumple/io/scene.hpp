@@ -55,6 +55,10 @@ struct HandleSpec {
   // border, 4 inside).
   bool tangentControl = false;
   int tangentVertices = 0;
+  // A finger's contact patch instead of tangent-plane vertices (m; 0 =
+  // the vertices): the node holds the points of the sheet at this radius
+  // around the handle, softly (pipeline::HandleRig, sim::Grip).
+  double patchRadius = 0.0;
   std::optional<double> releaseTime;  // s: the handle lets go at this time
 };
 

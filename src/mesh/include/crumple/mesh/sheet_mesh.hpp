@@ -67,6 +67,14 @@ void placePattern(SheetMesh& mesh, const Vec3& origin, const Vec3& uAxis, const 
 
 // Index of the vertex whose pattern position is nearest to p (lowest index on ties).
 int nearestPatternVertex(const SheetMesh& mesh, const Vec2& p);
+// The first triangle whose pattern holds p (its border included) and p's
+// barycentric weights in it (corner order); triangle -1 when p is outside
+// the pattern. Degenerate pattern triangles are skipped.
+struct PatternLocation {
+  int triangle = -1;
+  Vec3 weights = Vec3::Zero();
+};
+PatternLocation locatePattern(const SheetMesh& mesh, const Vec2& p);
 // Index of the vertex whose 3D position is nearest to p (lowest index on ties).
 int nearestVertex(const SheetMesh& mesh, const Vec3& p);
 

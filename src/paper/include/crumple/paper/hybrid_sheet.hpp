@@ -104,6 +104,16 @@ class HybridSheet {
   // tangent-plane vertices there).
   void setRebuildCallback(std::function<void(const mesh::SheetMesh&, double t)> callback);
 
+  // Fingers as contact patches (sim::Grip; pipeline::HandleRig::holdPatches):
+  // every elastic step holds the grips `grips` gives on the current S_P
+  // (asked again after each rebuild, like the pins), each moved with its
+  // anchor handle when that lags behind its node. Unset by default.
+  void setGrips(sim::GripFunction grips);
+  // A grip as firm as the sheet itself: the paper's in-plane stiffness
+  // (sim::Material::stretchStiffness, N/m) times the coarse FEM's
+  // membraneScale (paper Sec. 1: "stiffness of medium range").
+  double gripStiffness() const;
+
   // Called with every projection's input (paper Table III compares
   // projections on them, bench/harness/projection_comparison.cpp). Unset by
   // default (no cost).

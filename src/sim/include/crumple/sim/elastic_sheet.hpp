@@ -54,6 +54,22 @@ struct Pin {
 // (sub)step it takes, so halved substeps follow the handle curves exactly.
 using PinFunction = std::function<void(double t, std::vector<Pin>& out)>;
 
+// A soft hold: a finger's contact patch rather than a pinned vertex (paper
+// Sec. 4's tangent-plane control spread over an area). The point of
+// `triangle` at barycentric `weights` is drawn to `position` by a
+// zero-length spring of `stiffness` (N/m): energy k/2 |sum_a w_a x_a - p|^2
+// (gripEnergy). `anchor` is the pinned vertex (the handle) whose lag the
+// grip follows in a model that lets handles lag (-1: none).
+struct Grip {
+  int triangle = -1;
+  Vec3 weights = Vec3::Zero();
+  Vec3 position = Vec3::Zero();
+  double stiffness = 0.0;
+  int anchor = -1;
+};
+// Grips at any time t (s), asked for the end time of every (sub)step as the pins are.
+using GripFunction = std::function<void(double t, std::vector<Grip>& out)>;
+
 struct StepStats {
   int newtonIterations = 0;  // summed over the (sub)steps taken
   int halvings = 0;          // how many times a step was split
@@ -150,6 +166,10 @@ class ElasticSheet {
   // halves, down to params.maxHalvings; after that throws NumericalError
   // (stage "elastic") and leaves the state as it was before the call.
   StepStats advance(double t, double dt, const PinFunction& pins);
+  // Grips every step from now on holds (none by default). A step throws
+  // std::out_of_range for a grip on a missing triangle; a grip with a
+  // non-finite or negative value fails the substep like a non-finite pin.
+  void setGrips(GripFunction grips);
 
   // Contacts (docs/CONTACTS.md): free vertices keep options.distance from every
   // collider and, with self-contact, from the triangles of other layers of

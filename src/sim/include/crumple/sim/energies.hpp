@@ -81,6 +81,13 @@ double bendingEnergy(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3&
                      double stiffness, double restAngle, Vec12* gradient = nullptr,
                      Mat12* hessian = nullptr);
 
+// A grip (Grip, elastic_sheet.hpp): energy k/2 |w0 x0 + w1 x1 + w2 x2 - p|^2
+// (J) of a zero-length spring (k in N/m) between a point of a triangle and
+// its target p; gradient with respect to (x0, x1, x2) when requested. Its
+// Hessian is constant, k (w w^T) (x) I_3.
+double gripEnergy(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& weights,
+                  const Vec3& target, double stiffness, Vec9* gradient = nullptr);
+
 // Replace a symmetric matrix by its nearest positive semi-definite matrix
 // (negative eigenvalues clamped to zero). Returns true when it changed.
 bool projectToPsd(Mat9& m);
