@@ -111,12 +111,8 @@ double HybridSheet::Impl::keepElasticStepOutOfItself(const std::vector<Vec3>& x0
   return alpha;
 }
 
-// A lagging handle comes back along the straight line from where the step
-// finds it, at most lagCatchUpSpeed faster than its node moves; its
-// tangent-plane pins (listed after it, HandleRig::pins) keep their offsets
-// from it. Without this the first step whose structure lets the sheet follow
-// again closes the whole lag at once, and the sheet jumps (docs/CRUMPLING.md
-// "Popping").
+// A grip follows its anchor handle: by as much as catchUpPins keeps the
+// handle from its node, so a lagging finger's patch lags with it.
 sim::GripFunction HybridSheet::Impl::laggingGrips(const sim::PinFunction& pins,
                                                   const sim::PinFunction& nodePins) const {
   if (!grips) return {};
@@ -136,6 +132,12 @@ sim::GripFunction HybridSheet::Impl::laggingGrips(const sim::PinFunction& pins,
   };
 }
 
+// A lagging handle comes back along the straight line from where the step
+// finds it, at most lagCatchUpSpeed faster than its node moves; its
+// tangent-plane pins (listed after it, HandleRig::pins) keep their offsets
+// from it. Without this the first step whose structure lets the sheet follow
+// again closes the whole lag at once, and the sheet jumps (docs/CRUMPLING.md
+// "Popping").
 sim::PinFunction HybridSheet::Impl::catchUpPins(double t, double dt,
                                                 const sim::PinFunction& pins) const {
   const double speed = params.lagCatchUpSpeed;

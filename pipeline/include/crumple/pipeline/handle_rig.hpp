@@ -101,7 +101,7 @@ class HandleRig {
   // The held handles' positions at time t, limited to the sheet's reach;
   // `held` says which handles hold at t.
   std::vector<Vec3> heldTargets(double t, std::vector<char>& held) const;
-  // Binds h's patch on `sheet` at time t (holdPatches).
+  // Binds h's patch on `sheet` at time t ([[handles]] patch_radius).
   void bindPatch(BoundHandle& h, const mesh::SheetMesh& sheet, double t) const;
 
   const io::AnimationScene* animation_;

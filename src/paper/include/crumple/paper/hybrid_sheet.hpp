@@ -104,7 +104,7 @@ class HybridSheet {
   // tangent-plane vertices there).
   void setRebuildCallback(std::function<void(const mesh::SheetMesh&, double t)> callback);
 
-  // Fingers as contact patches (sim::Grip; pipeline::HandleRig::holdPatches):
+  // Fingers as contact patches (sim::Grip; [[handles]] patch_radius):
   // every elastic step holds the grips `grips` gives on the current S_P
   // (asked again after each rebuild, like the pins), each moved with its
   // anchor handle when that lags behind its node. Unset by default.
