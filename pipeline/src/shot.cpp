@@ -501,9 +501,9 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     rig.pins(t0, start);
     hybrid->placeVertices(start);
     hybrid->setTime(t0);
-    hybrid->setGrips([&rig, k = hybrid->gripStiffness()](double t, std::vector<sim::Grip>& out) {
-      rig.grips(t, k, out);
-    });
+    // A finger's grip is as firm as the sheet itself (the coarse FEM's).
+    hybrid->setGrips([&rig, k = hybrid->elastic().inPlaneStiffness()](
+                         double t, std::vector<sim::Grip>& out) { rig.grips(t, k, out); });
     hybrid->setRebuildCallback(
         [&rig](const mesh::SheetMesh& sp, double t) { rig.rebindTangents(sp, t); });
     if (options.projectionProbe) hybrid->setProjectionCallback(options.projectionProbe);
@@ -543,10 +543,11 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
                            : contact.self == sim::SelfContactMode::Off ? "off"
                                                                        : "auto";
   // Fingers that hold patches ([[handles]] patch_radius) grip as firmly as
-  // the sheet itself: its in-plane stiffness (N/m).
-  const auto holdGrips = [&rig, k = materialOf(scene.paper).stretchStiffness() *
-                                    params.membraneScale](sim::ElasticSheet& model) {
-    model.setGrips([&rig, k](double t, std::vector<sim::Grip>& out) { rig.grips(t, k, out); });
+  // the sheet itself.
+  const auto holdGrips = [&rig](sim::ElasticSheet& model) {
+    model.setGrips([&rig, k = model.inPlaneStiffness()](double t, std::vector<sim::Grip>& out) {
+      rig.grips(t, k, out);
+    });
   };
   if (elastic) elastic->setContacts(contact);
   if (elastic) holdGrips(*elastic);

@@ -139,10 +139,6 @@ HybridSheet& HybridSheet::operator=(HybridSheet&&) noexcept = default;
 
 void HybridSheet::setGrips(sim::GripFunction grips) { impl_->grips = std::move(grips); }
 
-double HybridSheet::gripStiffness() const {
-  return impl_->material.stretchStiffness() * impl_->simParams.membraneScale;
-}
-
 void HybridSheet::setRebuildCallback(
     std::function<void(const mesh::SheetMesh&, double t)> callback) {
   impl_->onRebuild = std::move(callback);

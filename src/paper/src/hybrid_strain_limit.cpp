@@ -118,6 +118,7 @@ sim::GripFunction HybridSheet::Impl::laggingGrips(const sim::PinFunction& pins,
   if (!grips) return {};
   return [this, pins, nodePins](double t, std::vector<sim::Grip>& out) {
     grips(t, out);
+    if (out.empty()) return;  // no finger holds a patch: nothing to pay for
     std::vector<sim::Pin> now, nodes;
     pins(t, now);
     nodePins(t, nodes);

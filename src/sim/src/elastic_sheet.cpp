@@ -482,6 +482,10 @@ double ElasticSheet::bendingEnergy() const {
   return e;
 }
 
+double ElasticSheet::inPlaneStiffness() const {
+  return (impl_->moduli.lambda + 2.0 * impl_->moduli.mu) * impl_->moduli.thickness;
+}
+
 double ElasticSheet::maxMembraneStrain() const {
   const Impl& m = *impl_;
   double worst = 0.0;

@@ -109,10 +109,6 @@ class HybridSheet {
   // (asked again after each rebuild, like the pins), each moved with its
   // anchor handle when that lags behind its node. Unset by default.
   void setGrips(sim::GripFunction grips);
-  // A grip as firm as the sheet itself: the paper's in-plane stiffness
-  // (sim::Material::stretchStiffness, N/m) times the coarse FEM's
-  // membraneScale (paper Sec. 1: "stiffness of medium range").
-  double gripStiffness() const;
 
   // Called with every projection's input (paper Table III compares
   // projections on them, bench/harness/projection_comparison.cpp). Unset by

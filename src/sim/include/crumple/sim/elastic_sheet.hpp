@@ -204,6 +204,10 @@ class ElasticSheet {
   double bendingEnergy() const;   // J
   // Max over triangles of the largest absolute principal Green strain.
   double maxMembraneStrain() const;
+  // The sheet's in-plane stiffness (lambda + 2 mu) h as this sheet runs it
+  // (N/m): Material::stretchStiffness times SimParams::membraneScale. A
+  // grip as firm as the sheet itself has this stiffness.
+  double inPlaneStiffness() const;
 
   // The membrane (Green strain) force each triangle around `vertex` exerts
   // on it at the current positions: minus the gradient of that triangle's
