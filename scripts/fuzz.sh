@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Fuzzing with libFuzzer (docs/FUZZING.md):
 #   scripts/fuzz.sh [TARGET|all] [SECONDS]
-# TARGET is scene, cache, gltf, fbx or collada (default all); each runs for
+# TARGET is scene, cache, cache_tools, gltf, fbx or collada (default all); each runs for
 # SECONDS (default 600), one after the other. Installs clang and libFuzzer's
 # runtime if missing, builds build-fuzz (clang, CRUMPLE_FUZZ=ON: ASan, UBSan,
 # coverage), and runs each fuzzer on a working corpus in
@@ -13,7 +13,7 @@
 # default 10), FUZZ_RSS_MB (default 2048), JOBS (build jobs, default 2).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-all_targets=(scene cache gltf fbx collada)
+all_targets=(scene cache cache_tools gltf fbx collada)
 which="${1:-all}"
 seconds="${2:-600}"
 timeout_s="${FUZZ_TIMEOUT:-10}"

@@ -596,6 +596,8 @@ struct CacheReader::Impl {
     return d;
   }
 
+  FrameRecord loadFullFrame(const InputFile& in, std::size_t index) const;
+
   std::shared_ptr<const Topology> topologyOf(const InputFile& in, std::size_t source) const {
     {
       std::lock_guard lock(topologyMutex);
@@ -726,6 +728,8 @@ CacheReader::CacheReader(const std::string& path) : impl_(std::make_unique<Impl>
   } catch (const FormatError& e) {
     throw InputError(path, std::string("damaged cache header: ") + e.what());
   }
+  if (const std::string problem = validate(r.header); !problem.empty())
+    throw InputError(path, "damaged cache header: " + problem);
   if (auto why = r.tryFooter(in, head.end)) r.scan(in, head.end, *why);
 }
 
@@ -751,6 +755,37 @@ FrameRecord CacheReader::readFrame(std::size_t index) const {
     throw std::out_of_range(r.path + ": frame index " + std::to_string(index) + " of " +
                             std::to_string(r.index.size()));
   const InputFile in(r.path);
+  FrameRecord f = r.loadFullFrame(in, index);
+  if (const std::string problem = validate(f, r.header); !problem.empty())
+    throw CorruptDataError(r.frameWhere(index) + problem);
+  return f;
+}
+
+std::vector<CacheIssue> CacheReader::verifyAll() const {
+  const Impl& r = *impl_;
+  std::vector<CacheIssue> issues;
+  std::optional<InputFile> in;
+  try {
+    in.emplace(r.path);
+  } catch (const InputError& e) {
+    issues.push_back({-1, e.what(), std::nullopt});
+    return issues;
+  }
+  for (std::size_t i = 0; i < r.index.size(); ++i) {
+    try {
+      const FrameRecord f = r.loadFullFrame(*in, i);
+      if (const std::string problem = validate(f, r.header); !problem.empty())
+        throw CorruptDataError(r.frameWhere(i) + problem);
+    } catch (const CorruptDataError& e) {
+      issues.push_back({static_cast<int>(i), e.what(), r.index[i].frame});
+    }
+  }
+  return issues;
+}
+
+// Frame `index` with its topology carried from the frame that holds it.
+FrameRecord CacheReader::Impl::loadFullFrame(const InputFile& in, std::size_t index) const {
+  const Impl& r = *this;
   DecodedFrame d = r.loadFrame(in, index);
   FrameRecord& f = d.record;
   const std::size_t source = r.index[index].topologySource;
@@ -771,26 +806,6 @@ FrameRecord CacheReader::readFrame(std::size_t index) const {
                           Topology{f.triangles, f.regionOfTriangle, f.regionTypes, f.pattern}));
   }
   return std::move(f);
-}
-
-std::vector<CacheIssue> CacheReader::verifyAll() const {
-  const Impl& r = *impl_;
-  std::vector<CacheIssue> issues;
-  std::optional<InputFile> in;
-  try {
-    in.emplace(r.path);
-  } catch (const InputError& e) {
-    issues.push_back({-1, e.what(), std::nullopt});
-    return issues;
-  }
-  for (std::size_t i = 0; i < r.index.size(); ++i) {
-    try {
-      r.loadFrame(*in, i);
-    } catch (const CorruptDataError& e) {
-      issues.push_back({static_cast<int>(i), e.what(), r.index[i].frame});
-    }
-  }
-  return issues;
 }
 
 // ===========================================================================

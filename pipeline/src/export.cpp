@@ -2,6 +2,7 @@
 #include "crumple/pipeline/export.hpp"
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -13,6 +14,7 @@
 #include "crumple/exporters/pcache.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/io/scene.hpp"
+#include "crumple/pipeline/inspect.hpp"
 
 namespace crumple::pipeline {
 namespace {
@@ -102,9 +104,10 @@ ExportReport exportCache(const std::string& cachePath, const ExportOptions& opti
       !options.outDir.empty()
           ? options.outDir
           : (fs::path(cachePath).parent_path() / "export" / exportFormatName(format)).string();
-  if (reader.recovered())
-    report.notes.push_back("the cache has no footer (an interrupted run?): it holds " +
-                           std::to_string(reader.frameCount()) + " complete frames");
+  if (std::string note = recoveredNote(reader); !note.empty()) {
+    if (options.log) std::fprintf(options.log, "crumple export: note: %s\n", note.c_str());
+    report.notes.push_back(std::move(note));
+  }
   // One UV square for the whole shot, whatever the range: the first cached
   // frame's pattern (the sheet at rest), so farm chunks agree.
   const exporters::UvMapping uv = exporters::uvMappingOf(

@@ -242,8 +242,12 @@ FrameViewBuilder::FrameViewBuilder(const io::SceneSpec& scene,
       m.name = specs[i]->name;
       m.color = specs[i]->color;
       m.vertices.resize(r.count(24));
-      for (Vec3& v : m.vertices)
+      for (Vec3& v : m.vertices) {
         for (int k = 0; k < 3; ++k) v[k] = r.get<double>();
+        if (!v.allFinite())
+          throw CorruptDataError("the cache's prop meshes: a vertex of '" + m.name +
+                                 "' is not finite");
+      }
       m.triangles.resize(r.count(12));
       for (auto& t : m.triangles)
         for (int& k : t) {
@@ -286,6 +290,9 @@ FrameView FrameViewBuilder::build(const cache::FrameRecord& frame) const {
       Mat4 motion;
       for (int c = 0; c < 4; ++c)
         for (int row = 0; row < 4; ++row) motion(row, c) = r.get<double>();
+      if (!motion.allFinite())
+        throw CorruptDataError("frame " + std::to_string(frame.frame) + ": the motion of prop '" +
+                               rest.name + "' is not finite");
       render::PropMesh m = rest;
       for (Vec3& v : m.vertices) v = (motion * v.homogeneous()).head<3>();
       fv.scene.props.push_back(std::move(m));

@@ -129,8 +129,12 @@ HandleRig::HandleRig(const io::SceneSpec& scene, const io::AnimationScene* anima
           "handle '" + h.name + "': node '" + h.node + "' is " + std::to_string(jump) +
           " m from its sheet vertex at the first frame; the vertex starts on the node");
     if (auto [it, inserted] = usedVertices.emplace(h.vertex, h.name); !inserted)
-      throw InputError(scene.file, "handles '" + it->second + "' and '" + h.name +
-                                       "' bind the same sheet vertex " + std::to_string(h.vertex));
+      throw InputError(scene.file, spec.patternPoint ? spec.patternLine : spec.nodeLine,
+                       spec.patternPoint ? "handles.pattern" : "handles.node",
+                       "handles '" + it->second + "' and '" + h.name +
+                           "' bind the same sheet vertex " + std::to_string(h.vertex) +
+                           " (their points are closer than the mesh's spacing; move one, or "
+                           "give [sheet] a finer max_edge)");
     if (spec.releaseTime) {
       h.releases = true;
       h.releaseTime = *spec.releaseTime;

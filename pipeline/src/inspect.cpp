@@ -223,6 +223,16 @@ FrameMetrics measure(const cache::CacheReader& reader, const cache::FrameRecord&
 
 }  // namespace
 
+std::string recoveredNote(const cache::CacheReader& reader) {
+  if (!reader.recovered()) return {};
+  const auto& h = reader.header();
+  const long long planned = static_cast<long long>(h.frameEnd) - h.frameStart + 1;
+  return reader.path() + " has no footer (a killed or still running shot?): it holds " +
+         std::to_string(reader.frameCount()) + " of the " + std::to_string(planned) +
+         " planned frames (" + std::to_string(h.frameStart) + "-" + std::to_string(h.frameEnd) +
+         ")";
+}
+
 std::string inspectJson(const cache::CacheReader& reader) {
   const auto& header = reader.header();
   JsonWriter j;
@@ -230,6 +240,9 @@ std::string inspectJson(const cache::CacheReader& reader) {
   j.key("format_version").value(static_cast<long long>(header.formatVersion));
   j.key("fps").value(header.fps);
   j.key("frame_count").value(reader.frameCount());
+  // A cache without its footer (a killed run) and the frames its shot planned.
+  j.key("recovered").value(reader.recovered());
+  j.key("planned_frames").value(static_cast<long long>(header.frameEnd) - header.frameStart + 1);
   const auto colliders = readColliders(reader);
   if (colliders) {
     j.key("colliders").beginArray();

@@ -2,11 +2,13 @@
 // 0 success, 1 internal failure (including a numerical failure that survived
 // substep halving), 2 bad input.
 #include <CLI/CLI.hpp>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -36,7 +38,7 @@ struct Args {
   std::string cache;
   std::string out;
   std::string frames;
-  std::optional<std::uint64_t> seed;
+  std::string seed;  // --seed as typed (parseSeed)
   int threads = 1;
   std::string backend = "osmesa";
   int spp = 16;
@@ -118,13 +120,26 @@ void addRenderOptions(CLI::App* cmd, Args& a) {
                 "installed");
 }
 
+// --seed: a whole number in [0, 2^63 - 1], the range the scene file's seed
+// takes (TOML integers), not wrapped around.
+std::uint64_t parseSeed(const std::string& text) {
+  std::uint64_t seed = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), seed);
+  if (text.empty() || text[0] == '-' || text[0] == '+' || ec != std::errc() ||
+      end != text.data() + text.size() ||
+      seed > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
+    throw InputError("--seed", "'" + text + "' is not a seed (a whole number from 0 to " +
+                                   std::to_string(std::numeric_limits<std::int64_t>::max()) + ")");
+  return seed;
+}
+
 int runOrSimulate(const Args& a, bool render) {
   setThreadCount(a.threads);
   const auto scene = io::loadScene(io::resolveScenePath(a.scene));
   pipeline::ShotOptions options;
   options.outDir = a.out;
   if (!a.frames.empty()) options.frames = pipeline::parseFrameRange(a.frames);
-  options.seed = a.seed;
+  if (!a.seed.empty()) options.seed = parseSeed(a.seed);
   options.render = render;
   options.debugStructure = a.debugStructure;
   options.checkpointEvery = a.checkpointEvery;
@@ -183,6 +198,7 @@ int soundCommand(const Args& a) {
       r.tearingEvents, r.gainDb, r.peak, static_cast<long long>(r.clipped), r.databasePath.c_str(),
       r.wavPath.c_str());
   if (!r.spectrogramPath.empty()) std::printf("  spectrogram: %s\n", r.spectrogramPath.c_str());
+  for (const auto& n : r.notes) std::printf("  note: %s\n", n.c_str());
   return 0;
 }
 
@@ -253,6 +269,8 @@ int compareCommand(const Args& a) {
     metric = render::ImageMetric::Psnr;
   else if (a.metric != "flip")
     throw InputError("--metric", "'" + a.metric + "' is not a metric (mae, psnr or flip)");
+  if (!std::isfinite(a.tolerance) || a.tolerance < 0.0)
+    throw InputError("--tolerance", "must be a finite number >= 0");
   const ImageRGBA8 ia = readImage(a.imageA);
   const ImageRGBA8 ib = readImage(a.imageB);
   if (ia.width != ib.width || ia.height != ib.height)
@@ -370,8 +388,8 @@ int main(int argc, char** argv) {
         "A-B: simulate from the scene's first frame to B, render A-B (default: the scene's range)");
     cmd->add_option(
         "--seed", a.seed,
-        "override the scene's seed (it places the crumpling model's singular vertices; the "
-        "elastic model draws no random numbers)");
+        "override the scene's seed, 0 ... 2^63 - 1 (it places the crumpling model's singular "
+        "vertices; the elastic model draws no random numbers)");
     cmd->add_option("--threads", a.threads, "worker threads; results are identical for any count")
         ->check(CLI::Range(1, 256));
     cmd->add_option("--checkpoint-every", a.checkpointEvery,
@@ -406,7 +424,9 @@ int main(int argc, char** argv) {
       "sounds from the events the simulation stored, heard from the camera; a WAV lasting "
       "exactly frame_count / fps, and its spectrogram PNG beside it.");
   soundCmd->add_option("CACHE", a.cache, "a .pcache file")->required();
-  soundCmd->add_option("--out", a.out, "the WAV file (default: sound.wav beside the cache)");
+  soundCmd->add_option("--out", a.out,
+                       "the WAV file, or a folder to write sound.wav into (default: sound.wav "
+                       "beside the cache)");
   soundCmd
       ->add_option("--rate", a.rate, "sample rate: 48000 or 44100 (default: the scene's, 48000)")
       ->check(CLI::IsMember({48000, 44100}));
@@ -418,7 +438,8 @@ int main(int argc, char** argv) {
                        "sound database folder (default: the scene's [sound] database, else "
                        "assets/sound/default)");
   soundCmd->add_option("--gain-db", a.gainDb,
-                       "a fixed gain in dB (default: the mix's peak normalised to -1 dBFS)");
+                       "a fixed gain in dB, -200 ... 200 (default: the mix's peak normalised to "
+                       "-1 dBFS)");
   soundCmd->add_flag("--no-spectrogram", a.noSpectrogram, "do not write the PNG");
   soundCmd->add_flag("--events", a.listEvents,
                      "print the cache's sound events, one line each, and make no sound");
@@ -533,6 +554,20 @@ int main(int argc, char** argv) {
   benchCmd->add_option("--source", a.bench.sourceDir,
                        "the source tree whose samples/ are run (default: this build's)");
 
+  // A first word that is neither an option nor a command is named, with the commands.
+  if (argc > 1 && argv[1][0] != '-') {
+    std::string names;
+    bool known = false;
+    for (const CLI::App* sub : app.get_subcommands({})) {
+      known = known || sub->get_name() == argv[1];
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!known) {
+      std::fprintf(stderr, "crumple: error: '%s' is not a command (one of: %s; see --help)\n",
+                   argv[1], names.c_str());
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

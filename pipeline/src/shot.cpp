@@ -19,8 +19,10 @@
 #include <tuple>
 
 #include "checkpoint.hpp"
+#include "cost_guard.hpp"
 #include "crumple/core/error.hpp"
 #include "crumple/core/progress.hpp"
+#include "crumple/core/work_budget.hpp"
 #include "crumple/exporters/pcache_contacts.hpp"
 #include "crumple/exporters/pcache_sound.hpp"
 #include "crumple/exporters/pcache_structure.hpp"
@@ -319,13 +321,19 @@ void validateRange(const io::SceneSpec& scene, const FrameRange& range) {
 
 void writeTextAtomically(const std::string& path, const std::string& text) {
   const std::string tmp = path + ".tmp";
+  bool written = false;
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(path, "cannot write");
     out << text;
-    if (!out) throw InputError(path, "cannot write");
+    out.close();
+    written = static_cast<bool>(out);
   }
-  fs::rename(tmp, path);
+  std::error_code ec;
+  if (written) fs::rename(tmp, path, ec);
+  if (!written || ec) {
+    fs::remove(tmp, ec);  // a full disk leaves no temporary behind
+    throw InputError(path, "cannot write");
+  }
 }
 
 }  // namespace
@@ -1110,9 +1118,24 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
                    checkpointPath.c_str());
   }
 
+  // The cost guard (cost_guard.hpp): each frame's wall-clock budget and
+  // halvings, and what most likely made a stopped frame dear.
+  CostGuard guard(scene.frameBudget);
+  int currentFrame = firstFrame;
+  Clock::time_point frameStart = Clock::now();
+  long halvingsBefore = 0;
+  const auto frameDone = [&](int frame) {
+    guard.frameDone(
+        frame, msSince(frameStart) / 1000.0, report.halvings - halvingsBefore,
+        likelyCostCause(rig, record.pattern, frameTime(scene, frame), frameTime(scene, frame - 1)));
+  };
   try {
     if (!resumed) emit(scene.frameStart);
     for (int frame = firstFrame; frame <= range.last; ++frame) {
+      currentFrame = frame;
+      frameStart = Clock::now();
+      halvingsBefore = report.halvings;
+      const ScopedWorkBudget frameBudget(guard.budget());
       if (hybrid) {
         // The frame's substeps are the paper's animation steps (Fig. 16):
         // each an elastic step, the geometric step, cones, S_P rebuild and
@@ -1162,6 +1185,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
         if (options.checkpointEvery > 0 &&
             (frame - scene.frameStart) % options.checkpointEvery == 0)
           checkpoint(frame);
+        frameDone(frame);
         continue;
       }
       const auto start = Clock::now();
@@ -1188,8 +1212,19 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
       emit(frame);
       if (options.checkpointEvery > 0 && (frame - scene.frameStart) % options.checkpointEvery == 0)
         checkpoint(frame);
+      frameDone(frame);
     }
-  } catch (const NumericalError& e) {
+  } catch (const NumericalError& caught) {
+    // A frame that ran out of its budget in any stage is the cost guard's stop.
+    const double budget = guard.budget();
+    const bool overBudget =
+        budget > 0.0 && msSince(frameStart) / 1000.0 >= budget && caught.stage() != "cost guard";
+    const NumericalError e =
+        overBudget
+            ? guard.budgetError(currentFrame, caught.stage(),
+                                likelyCostCause(rig, record.pattern, frameTime(scene, currentFrame),
+                                                frameTime(scene, currentFrame - 1)))
+            : caught;
     progress.finish();
     report.error = e.what();
     report.hybrid = hybridModel;
@@ -1197,7 +1232,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     writer->close();  // the cache stays valid up to the last good frame
     stabilityWarnings();
     writeSummary(scene, report, options);
-    throw;
+    throw e;
   }
   progress.finish();
   writer->close();
@@ -1249,6 +1284,10 @@ RenderReport renderCache(const std::string& cachePath, const RenderOptions& opti
                      fs::path(header.sceneFile).parent_path().string(),
                      /*checkFiles=*/false);
   RenderReport report;
+  if (std::string note = recoveredNote(reader); !note.empty()) {
+    if (options.log) std::fprintf(options.log, "crumple render: note: %s\n", note.c_str());
+    report.notes.push_back(std::move(note));
+  }
   report.framesDir = !options.framesDir.empty()
                          ? options.framesDir
                          : (fs::path(cachePath).parent_path() / "frames").string();

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <sstream>
@@ -11,6 +12,7 @@
 #include "crumple/core/progress.hpp"
 #include "crumple/exporters/pcache.hpp"
 #include "crumple/exporters/png.hpp"
+#include "crumple/pipeline/inspect.hpp"
 #include "crumple/sound/database.hpp"
 #include "crumple/sound/soundtrack.hpp"
 #include "crumple/sound/spectrogram.hpp"
@@ -93,10 +95,41 @@ std::string defaultSoundDatabase() {
   return (fs::path(CRUMPLE_SOURCE_ASSETS) / "sound" / "default").string();
 }
 
+namespace {
+
+// A gain beyond this is no mix (200 dB is a factor of 1e10).
+constexpr int kMaxGainDb = 200;
+
+// The WAV: --out as given, DIR/sound.wav when --out names a folder (an
+// existing one, or a path ending in '/'), else sound.wav beside the cache.
+std::string soundPath(const std::string& cachePath, const std::string& out) {
+  if (out.empty()) return (fs::path(cachePath).parent_path() / "sound.wav").string();
+  std::error_code ec;
+  if (out.back() == '/' || fs::is_directory(out, ec)) return (fs::path(out) / "sound.wav").string();
+  return out;
+}
+
+// A frame's SEVT block, its errors naming the cache and the frame.
+std::optional<std::vector<cache::SoundEventRecord>> frameEvents(const std::string& cachePath,
+                                                                const cache::FrameRecord& record) {
+  try {
+    return cache::decodeSoundEvents(record.extensions);
+  } catch (const CorruptDataError& e) {
+    throw CorruptDataError(cachePath + ": frame " + std::to_string(record.frame) + ": " + e.what());
+  }
+}
+
+}  // namespace
+
 SoundReport makeSound(const std::string& cachePath, const SoundOptions& options) {
   const cache::CacheReader reader(cachePath);
   if (reader.frameCount() == 0) throw InputError(cachePath, "the cache holds no frames");
   const auto& header = reader.header();
+  SoundReport report;
+  if (std::string note = recoveredNote(reader); !note.empty()) {
+    if (options.log) std::fprintf(options.log, "crumple sound: note: %s\n", note.c_str());
+    report.notes.push_back(std::move(note));
+  }
   if (!cache::decodeSoundSetup(header.extensions))
     throw InputError(cachePath,
                      "the cache has no sound events: its scene had no [sound] table when it was "
@@ -105,7 +138,6 @@ SoundReport makeSound(const std::string& cachePath, const SoundOptions& options)
       io::parseScene(header.sceneText, header.sceneFile + " (in " + cachePath + ")",
                      fs::path(header.sceneFile).parent_path().string(),
                      /*checkFiles=*/false);
-  SoundReport report;
   report.sampleRate = options.sampleRate.value_or(scene.sound.sampleRate);
   if (!sound::supportedSampleRate(report.sampleRate))
     throw InputError("--rate", std::to_string(report.sampleRate) + " Hz: 48000 or 44100");
@@ -116,11 +148,9 @@ SoundReport makeSound(const std::string& cachePath, const SoundOptions& options)
   report.databasePath = !options.database.empty()       ? options.database
                         : !scene.sound.database.empty() ? scene.sound.database
                                                         : defaultSoundDatabase();
-  report.wavPath = !options.out.empty()
-                       ? options.out
-                       : (fs::path(cachePath).parent_path() / "sound.wav").string();
-  if (options.gainDb && !std::isfinite(*options.gainDb))
-    throw InputError("--gain-db", "must be a finite number of dB");
+  report.wavPath = soundPath(cachePath, options.out);
+  if (options.gainDb && !(std::abs(*options.gainDb) <= kMaxGainDb))
+    throw InputError("--gain-db", "must be a number of dB within +-" + std::to_string(kMaxGainDb));
 
   const sound::SoundDatabase db =
       sound::SoundDatabase::load(report.databasePath).resampledTo(report.sampleRate);
@@ -135,7 +165,7 @@ SoundReport makeSound(const std::string& cachePath, const SoundOptions& options)
     sound::FrameEvents& f = frames[i];
     f.listener = scene.sound.listener.value_or(record.camera.position);
     f.right = record.camera.rotation * Vec3::UnitX();
-    if (const auto events = cache::decodeSoundEvents(record.extensions))
+    if (const auto events = frameEvents(cachePath, record))
       for (const auto& r : *events) {
         f.events.push_back(soundEventOf(r));
         switch (r.kind) {
@@ -184,6 +214,8 @@ SoundReport makeSound(const std::string& cachePath, const SoundOptions& options)
     report.clipped = sound::writeWav(
         wavTmp, audio, floatSamples ? sound::SampleFormat::Float32 : sound::SampleFormat::Pcm24);
   } catch (const std::runtime_error& e) {
+    std::error_code ec;
+    fs::remove(wavTmp, ec);  // a full disk leaves no temporary behind
     throw InputError(report.wavPath, e.what());
   }
   renameInto(wavTmp, wav);
@@ -206,7 +238,7 @@ std::string eventTimeline(const std::string& cachePath) {
   char line[256];
   for (std::size_t i = 0; i < reader.frameCount(); ++i) {
     const cache::FrameRecord record = reader.readFrame(i);
-    const auto events = cache::decodeSoundEvents(record.extensions);
+    const auto events = frameEvents(cachePath, record);
     if (!events) continue;
     for (const auto& e : *events) {
       std::snprintf(line, sizeof line, "%d %.4f %s %.4g %.3f %.3f %.3f |", record.frame,

@@ -366,7 +366,12 @@ TEST_F(PcacheTest, DamagedTopologyFrameFailsTheFramesThatShareIt) {
     EXPECT_TRUE(contains(e.what(), "frame 13")) << e.what();
     EXPECT_TRUE(contains(e.what(), "CRC")) << e.what();
   }
-  ASSERT_EQ(r.verifyAll().size(), 1u);
+  // Frame 13's chunk, and frames 14 and 15, whose topology it holds.
+  const auto issues = r.verifyAll();
+  ASSERT_EQ(issues.size(), 3u);
+  EXPECT_EQ(issues[0].frame, 13);
+  EXPECT_TRUE(contains(issues[0].message, "CRC")) << issues[0].message;
+  EXPECT_TRUE(contains(issues[1].message, "its topology is unreadable")) << issues[1].message;
 }
 
 TEST_F(PcacheTest, FlippedByteWithoutFooterStopsRecoveryBeforeIt) {

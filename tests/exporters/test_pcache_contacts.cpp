@@ -37,6 +37,13 @@ std::vector<ContactRecord> someContacts() {
           {2147483647, 1, 0.1f, 1e-30f}};
 }
 
+// Contacts a four-vertex frame can hold (the reader checks vertices against it).
+std::vector<ContactRecord> frameContacts() {
+  auto contacts = someContacts();
+  contacts.back().vertex = 2;
+  return contacts;
+}
+
 bool sameBits(float a, float b) {
   return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b);
 }
@@ -108,7 +115,7 @@ TEST_F(PcacheContactsTest, RoundTripThroughACacheFile) {
   CacheHeader h = makeHeader();
   h.extensions = {encodeColliders(someColliders())};
   FrameRecord f1 = makeFrame(1), f2 = makeFrame(2), f3 = makeFrame(3);
-  f1.extensions = {encodeContacts(someContacts())};
+  f1.extensions = {encodeContacts(frameContacts())};
   f2.extensions = {encodeContacts({})};  // touched nothing, said so
   // f3: no CONT block at all.
   {
@@ -126,7 +133,7 @@ TEST_F(PcacheContactsTest, RoundTripThroughACacheFile) {
   ASSERT_EQ(r.frameCount(), 3u);
   const auto c1 = decodeContacts(r.readFrame(0).extensions);
   ASSERT_TRUE(c1.has_value());
-  expectSameContacts(*c1, someContacts());
+  expectSameContacts(*c1, frameContacts());
   const auto c2 = decodeContacts(r.readFrame(1).extensions);
   ASSERT_TRUE(c2.has_value());
   EXPECT_TRUE(c2->empty());
@@ -270,7 +277,7 @@ TEST_F(PcacheContactsTest, BlocksAreKeptVerbatimAlongsideOthers) {
                   {{'N', 'O', 'T', 'E'}, {}}};
   FrameRecord f1 = makeFrame(1), f2 = makeFrame(2);
   f1.extensions = {{{'P', 'R', 'P', 'M'}, Bytes(128, 0x3F)},
-                   encodeContacts(someContacts()),
+                   encodeContacts(frameContacts()),
                    {{'S', 'N', 'D', ' '}, {1, 2, 3}}};
   f2.extensions = {encodeContacts({{1, 0, 0.5f, 3.0f}}), {{'\0', '\1', '\2', '\3'}, {0}}};
   {
@@ -285,7 +292,7 @@ TEST_F(PcacheContactsTest, BlocksAreKeptVerbatimAlongsideOthers) {
   const FrameRecord g1 = r.readFrame(0), g2 = r.readFrame(1);
   EXPECT_EQ(g1.extensions, f1.extensions);
   EXPECT_EQ(g2.extensions, f2.extensions);
-  expectSameContacts(*decodeContacts(g1.extensions), someContacts());
+  expectSameContacts(*decodeContacts(g1.extensions), frameContacts());
   expectSameContacts(*decodeContacts(g2.extensions), {{1, 0, 0.5f, 3.0f}});
   EXPECT_TRUE(r.verifyAll().empty());
 
@@ -297,6 +304,34 @@ TEST_F(PcacheContactsTest, BlocksAreKeptVerbatimAlongsideOthers) {
     w.close();
   }
   EXPECT_EQ(test::readBytes(copy), test::readBytes(path));
+}
+
+// A CRC-valid cache whose contacts name a vertex the frame does not have, or
+// a collider the header does not list, is refused by the reader with the
+// block named, before any tool indexes the frame's arrays with them.
+TEST_F(PcacheContactsTest, TheReaderRefusesContactsOutsideTheFrame) {
+  for (const ContactRecord bad : {ContactRecord{4, 0, 0.0f, 0.0f},     // 4 vertices: 0..3
+                                  ContactRecord{1, 3, 0.0f, 0.0f}}) {  // 3 colliders
+    const std::string path = file("bad.pcache");
+    CacheHeader h = makeHeader();
+    h.extensions = {encodeColliders(someColliders())};
+    FrameRecord f = makeFrame(1);
+    f.extensions = {encodeContacts({bad})};
+    {
+      CacheWriter w(path, h);
+      w.append(f);
+      w.close();
+    }
+    const CacheReader r(path);
+    try {
+      (void)r.readFrame(0);
+      FAIL() << "contact " << bad.vertex << "/" << bad.collider << " was read";
+    } catch (const CorruptDataError& e) {
+      EXPECT_NE(std::string(e.what()).find("frame 1"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("CONT sub-block"), std::string::npos) << e.what();
+    }
+    ASSERT_EQ(r.verifyAll().size(), 1u);
+  }
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "crumple/exporters/pcache_sound.hpp"
 #include "crumple/exporters/pcache_tear.hpp"
 #include "fuzz_input.hpp"
+#include "fuzz_pcache.hpp"
 
 namespace {
 
@@ -64,36 +65,11 @@ void readCache(const std::uint8_t* data, std::size_t size) {
   }
 }
 
-std::uint64_t littleEndian(const std::uint8_t* p, int bytes) {
-  std::uint64_t v = 0;
-  for (int i = bytes - 1; i >= 0; --i) v = (v << 8) | p[i];
-  return v;
-}
-
-// The input with the CRC of every chunk that fits in it recomputed
-// (docs/PCACHE.md "Chunks": tag, u32 version, u64 length L, L bytes, u32 CRC
-// of all before it), walking the chunks from the magic on.
-std::vector<std::uint8_t> withValidCrcs(const std::uint8_t* data, std::size_t size) {
-  constexpr std::size_t kMagic = 8, kPrefix = 16, kCrc = 4;
-  std::vector<std::uint8_t> bytes(data, data + size);
-  std::size_t offset = kMagic;
-  while (offset + kPrefix + kCrc <= size) {
-    const std::uint64_t length = littleEndian(bytes.data() + offset + 8, 8);
-    if (length > size - offset - kPrefix - kCrc) break;
-    const std::size_t end = offset + kPrefix + static_cast<std::size_t>(length);
-    const std::uint32_t crc = crumple::crc32(bytes.data() + offset, end - offset);
-    for (std::size_t i = 0; i < kCrc; ++i)
-      bytes[end + i] = static_cast<std::uint8_t>(crc >> (8 * i));
-    offset = end + kCrc;
-  }
-  return bytes;
-}
-
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   readCache(data, size);
-  const std::vector<std::uint8_t> fixed = withValidCrcs(data, size);
+  const std::vector<std::uint8_t> fixed = crumple::fuzz::withValidCrcs(data, size);
   if (!std::equal(fixed.begin(), fixed.end(), data)) readCache(fixed.data(), fixed.size());
   return 0;
 }

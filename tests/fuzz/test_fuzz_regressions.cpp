@@ -28,6 +28,7 @@
 
 extern "C" int crumpleFuzz_scene(const std::uint8_t* data, std::size_t size);
 extern "C" int crumpleFuzz_cache(const std::uint8_t* data, std::size_t size);
+extern "C" int crumpleFuzz_cache_tools(const std::uint8_t* data, std::size_t size);
 extern "C" int crumpleFuzz_gltf(const std::uint8_t* data, std::size_t size);
 extern "C" int crumpleFuzz_fbx(const std::uint8_t* data, std::size_t size);
 extern "C" int crumpleFuzz_collada(const std::uint8_t* data, std::size_t size);
@@ -46,6 +47,7 @@ void PrintTo(const Target& target, std::ostream* os) { *os << target.name; }
 
 const Target kTargets[] = {{"scene", crumpleFuzz_scene},
                            {"cache", crumpleFuzz_cache},
+                           {"cache_tools", crumpleFuzz_cache_tools},
                            {"gltf", crumpleFuzz_gltf},
                            {"fbx", crumpleFuzz_fbx},
                            {"collada", crumpleFuzz_collada}};
@@ -126,7 +128,10 @@ TEST(FuzzSeeds, SceneSeedsParse) {
 }
 
 TEST(FuzzSeeds, CacheSeedsReadWithoutIssues) {
-  for (const fs::path& seed : inputsIn(fs::path(CRUMPLE_FUZZ_DIR) / "corpus" / "cache")) {
+  std::vector<fs::path> seeds = inputsIn(fs::path(CRUMPLE_FUZZ_DIR) / "corpus" / "cache");
+  for (const fs::path& seed : inputsIn(fs::path(CRUMPLE_FUZZ_DIR) / "corpus" / "cache_tools"))
+    seeds.push_back(seed);
+  for (const fs::path& seed : seeds) {
     SCOPED_TRACE(seed.string());
     const crumple::cache::CacheReader reader(seed.string());
     EXPECT_FALSE(reader.recovered());

@@ -319,10 +319,15 @@ struct AnimationScene::Impl {
         fail("node '" + node + "': non-finite " + what + " key " + std::to_string(i) +
              " (t = " + fmt(t) + " s)");
       }
+      // Keys in time order (glTF 2.0 Sec. 3.11: animation inputs increase);
+      // a key before its predecessor is an authoring error, not resorted.
+      if (!kv.empty() && t < kv.back().first) {
+        fail("node '" + node + "': " + what + " key " + std::to_string(i) + " at t = " + fmt(t) +
+             " s comes before key " + std::to_string(i - 1) + " (t = " + fmt(kv.back().first) +
+             " s): key times must not decrease");
+      }
       kv.emplace_back(t, v);
     }
-    std::stable_sort(kv.begin(), kv.end(),
-                     [](const auto& a, const auto& b) { return a.first < b.first; });
     for (auto& [t, v] : kv) {
       times.push_back(t);
       values.push_back(v);

@@ -2,6 +2,7 @@
 #include "crumple/io/scene.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <iterator>
@@ -27,7 +28,14 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxSubsteps = 1024;
+// The OSMesa preview's limits on Debian 12's Mesa 22.3 (llvmpipe): a side up
+// to GL_MAX_RENDERBUFFER_SIZE, and its 4-sample colour buffer within 2 GiB
+// (measured: 11584 x 11584 renders, 11600 x 11600 and 16384 x 16384 give an
+// incomplete framebuffer; docs/RELIABILITY.md).
 constexpr std::int64_t kMaxResolution = 16384;
+constexpr std::int64_t kMaxPixels = std::int64_t{1} << 27;
+constexpr double kMaxSheetSide = 100.0;  // m
+constexpr double kMaxSheetVertices = 1'000'000;
 // Upper limits of the hybrid parameters: far beyond any useful value, they
 // catch numbers written in another unit (per m instead of per cm, ...).
 constexpr double kMaxRhoBoundPerCm = 100.0;   // 0.1 mm between boundary samples
@@ -107,9 +115,22 @@ class SceneParser {
     spec_.name = defaultName();
     if (!table) return;
     const TableReader r(*table, "scene", file_);
-    r.allowOnly({"name", "units", "fps", "frames", "substeps", "seed", "animation"});
+    r.allowOnly(
+        {"name", "units", "fps", "frames", "substeps", "seed", "animation", "frame_budget_s"});
+    if (auto budget = r.number("frame_budget_s")) {
+      if (!(*budget >= 0.0) || *budget > 1e6)
+        r.fail("frame_budget_s", "must be in [0, 1e6] seconds (0: the cost guard is off)");
+      spec_.frameBudget = *budget;
+    }
     if (auto name = r.string("name")) {
       if (name->empty()) r.fail("name", "must not be empty");
+      // It names the default output folder out/<name>/: one plain folder name.
+      if (*name == "." || *name == ".." || name->find_first_of("/\\") != std::string::npos ||
+          std::any_of(name->begin(), name->end(),
+                      [](char c) { return static_cast<unsigned char>(c) < 0x20; }))
+        r.fail(
+            "name",
+            "'" + *name + "' is not a folder name (no '/', '\\', control characters, '.' or '..')");
       spec_.name = *name;
     }
     if (auto units = r.string("units")) {
@@ -148,6 +169,10 @@ class SceneParser {
     if (auto anim = r.string("animation")) {
       if (anim->empty()) r.fail("animation", "must not be empty");
       fs::path p(*anim);
+      std::string ext = p.extension().string();
+      for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      if (ext != ".gltf" && ext != ".glb" && ext != ".fbx" && ext != ".dae")
+        r.fail("animation", "'" + *anim + "' is not a .gltf, .glb, .fbx or .dae file");
       if (p.is_relative()) p = fs::path(baseDir_.empty() ? "." : baseDir_) / p;
       p = p.lexically_normal();
       std::error_code ec;
@@ -215,6 +240,25 @@ class SceneParser {
         r.fail("max_edge", "is larger than the sheet itself");
       }
     }
+    if (s.kind != SheetSpec::Kind::PatternMesh) checkSheetSize(r, s);
+  }
+
+  // A sheet the mesh and the models can hold (docs/RELIABILITY.md): no side
+  // over kMaxSheetSide, and about area / (0.87 max_edge^2) vertices (the
+  // triangular lattice of mesh::makeRectangleSheet) within kMaxSheetVertices.
+  void checkSheetSize(const TableReader& r, const SheetSpec& s) const {
+    const char* side = r.has("outline") ? "outline" : s.width >= s.height ? "width" : "height";
+    if (std::max(s.width, s.height) > kMaxSheetSide)
+      r.fail(side, formatNumber(std::max(s.width, s.height) / mpu()) +
+                       " is not a sheet of paper (at most " + formatNumber(kMaxSheetSide / mpu()) +
+                       " in the scene's units)");
+    const double edge = s.maxEdge > 0.0 ? s.maxEdge : std::min(s.width, s.height) / 16.0;
+    const double vertices = s.width * s.height / (0.866 * edge * edge);
+    if (vertices > kMaxSheetVertices)
+      r.fail(r.has("max_edge") ? "max_edge" : side,
+             "the sheet would have about " + formatNumber(std::round(vertices)) +
+                 " vertices, more than " + formatNumber(kMaxSheetVertices) +
+                 " (raise max_edge or use a smaller sheet)");
   }
 
   // [sheet] outline = [[u, v], ...]: at least 3 points, none negative, a
@@ -387,6 +431,7 @@ class SceneParser {
           }
         }
         h.patternPoint = q;
+        h.patternLine = r.lineOf("pattern");
       }
       h.tangentControl = r.boolean("tangent_control").value_or(false);
       if (auto n = r.integer("tangent_vertices")) {
@@ -431,6 +476,10 @@ class SceneParser {
                                    "] (got " + std::to_string(v) + ")");
         }
       }
+      if ((*res)[0] * (*res)[1] > kMaxPixels)
+        r.fail("resolution", std::to_string((*res)[0] * (*res)[1]) + " pixels, more than the " +
+                                 std::to_string(kMaxPixels) +
+                                 " the renderers can draw (11584 x 11584)");
       c.width = static_cast<int>((*res)[0]);
       c.height = static_cast<int>((*res)[1]);
     }

@@ -14,6 +14,7 @@
 
 #include "crumple/core/error.hpp"
 #include "crumple/core/geometry2d.hpp"
+#include "crumple/core/work_budget.hpp"
 #include "crumple/paper/boundary_curve.hpp"
 #include "crumple/paper/cone_fit.hpp"
 #include "crumple/paper/damage.hpp"
@@ -388,6 +389,8 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
   m.elastic->setGrips(m.laggingGrips(pins, nodePins));
   try {
     stats.elastic = m.elastic->advance(t, dt, pins);
+  } catch (const WorkBudgetExceeded&) {
+    throw;  // the shot's cost guard: no retry
   } catch (const NumericalError&) {
     // The isometry leaves the tangent-plane pins where the lengths put them
     // (isometryHoldsTangentPins); when the elastic step cannot pull them back

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "crumple/core/error.hpp"
+#include "crumple/core/work_budget.hpp"
 #include "pattern_edges.hpp"
 
 namespace crumple::paper {
@@ -65,6 +66,7 @@ int IsometryProjector::Impl::polishLengths(std::vector<Vec3>& p) const {
   }
   int sweeps = 0;
   while (sweeps < options.lengthSweeps) {
+    checkWorkBudget("isometry");  // the shot's cost guard (core/work_budget.hpp)
     double worst = 0.0;
     for (const Rod& r : rods) {
       Vec3& pi = p[static_cast<std::size_t>(r.i)];

@@ -13,6 +13,8 @@
 #include <tuple>
 #include <utility>
 
+#include "crumple/core/work_budget.hpp"
+
 namespace crumple::paper {
 
 namespace {
@@ -252,6 +254,7 @@ LengthProjectionStats LengthProjector::solve(std::vector<Vec3>& x, const std::ve
   std::vector<Vec3> bestX = x;
   double bestMax = stats.maxBefore;
   for (int it = 0; it < maxIterations; ++it) {
+    checkWorkBudget("strain limit");  // the shot's cost guard (core/work_budget.hpp)
     objective.assemble(x, H, g);
     Eigen::VectorXd diag = H.diagonal();
     double floor = 1e-9 * std::max(1e-300, diag.maxCoeff());

@@ -2,6 +2,7 @@
 // with a backtracking line search, substep halving and the recovery of a
 // step that failed at every halving (the method: elastic_sheet.cpp's header
 // comment; paper Sec. 4, thesis 2.3.1).
+#include "crumple/core/work_budget.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
 #include "elastic_sheet_impl.hpp"
 
@@ -399,6 +400,7 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
   // Nothing to solve when every vertex is pinned: the step is the pins.
   bool converged = freeCount == 0;
   for (int it = 0; !converged && it < params.maxNewtonIterations; ++it) {
+    checkWorkBudget("elastic");  // the shot's cost guard (core/work_budget.hpp)
     // Exact element Hessians first (quadratic convergence); projected to PSD
     // only if the assembled system turns out not to be positive definite.
     evaluate(s.xk, true, false);

@@ -125,6 +125,16 @@ class CacheWriter {
   std::unique_ptr<Impl> impl_;
 };
 
+// What the reader checks of decoded data before it hands it out
+// (docs/PCACHE.md "What the reader checks"): an empty string when valid,
+// else the first problem, naming the block. The header: a positive finite
+// fps, planned frames in order, substeps >= 1, finite non-negative sizes.
+// A frame (its topology carried): sizes that agree, every index (triangles,
+// regions, singular and junction vertices, rulings, handles, contacts and
+// their colliders) within the frame's own counts, every real finite.
+std::string validate(const CacheHeader& header);
+std::string validate(const FrameRecord& frame, const CacheHeader& header);
+
 // A problem found while reading: which frame (or -1 for header/footer).
 struct CacheIssue {
   int frameIndex = -1;

@@ -98,14 +98,18 @@ double poppingMeasure(const cache::FrameRecord& previous, const cache::FrameReco
 // e.g. for mesh::validate.
 mesh::SheetMesh sheetOfFrame(const cache::FrameRecord& frame);
 
+// The notice for a cache recovered without its footer (a killed or still
+// running shot): the file, and how many of the header's planned frames it
+// holds. Empty for a complete cache. `render`, `sound` and `export` print it
+// on stderr and in their closing summary.
+std::string recoveredNote(const cache::CacheReader& reader);
+
 // The `inspect --json` object: {"format_version", "fps", "frame_count",
-// "frames": [...]} -- later features extend it but never rename a key. A
-// cache whose header has COLL adds "colliders": [{"name", "material",
-// "friction"}] and, per frame, "contacts" and "max_slide_speed" (m/s).
-// Every frame has "angle_defect_mean", "angle_defect_max",
-// "angle_defect_total" (rad), "angle_defect_vertices", "popping" and
-// "extent" ([x, y, z], m: the bounding box of the sheet)
-// (FrameMetrics).
+// "recovered", "planned_frames", "frames": [...]} -- later features extend it but never rename a
+// key. A cache whose header has COLL adds "colliders": [{"name", "material", "friction"}] and, per
+// frame, "contacts" and "max_slide_speed" (m/s). Every frame has "angle_defect_mean",
+// "angle_defect_max", "angle_defect_total" (rad), "angle_defect_vertices", "popping" and "extent"
+// ([x, y, z], m: the bounding box of the sheet) (FrameMetrics).
 std::string inspectJson(const cache::CacheReader& reader);
 // The human-readable table (with the colliders and a contacts and a max
 // slide speed column when the header has COLL).

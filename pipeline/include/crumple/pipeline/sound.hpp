@@ -45,7 +45,8 @@ struct SoundReport {
   double gainDb = 0.0;  // applied to the mix
   double peak = 0.0;    // after the gain (full scale 1)
   std::int64_t clipped = 0;
-  double synthesisMs = 0.0;  // the mix, without reading the cache or writing files
+  double synthesisMs = 0.0;        // the mix, without reading the cache or writing files
+  std::vector<std::string> notes;  // e.g. a cache recovered without its footer
 };
 
 // A sound event and its cache record (SEVT), both ways.

@@ -50,6 +50,7 @@ struct HandleSpec {
   std::string node;                  // animated node in the animation file
   long nodeLine = 0;                 // scene file line of `node` (for errors)
   std::optional<Vec2> patternPoint;  // m; nullopt = sheet point nearest the node at the first frame
+  long patternLine = 0;              // scene file line of `pattern` (for errors)
   // Tangent-plane control (thesis 2.3.1): the node's rotation drives 2-4
   // neighbour vertices. tangentVertices 0 = automatic (2 at a corner, 3 on a
   // border, 4 inside).
@@ -261,6 +262,10 @@ struct SceneSpec {
   int frameEnd = 48;  // inclusive
   int substeps = 4;
   std::uint64_t seed = 1;
+  // [scene] frame_budget_s: the cost guard's wall-clock budget for one frame
+  // (docs/RELIABILITY.md "The cost guard"). Unset (nullopt): derived from the
+  // shot's own frame times; 0: the cost guard is off.
+  std::optional<double> frameBudget;
   SheetSpec sheet;
   std::string paperPreset = "office-70gsm";
   PaperPreset paper;  // resolved preset
