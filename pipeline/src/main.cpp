@@ -364,7 +364,9 @@ int main(int argc, char** argv) {
   for (auto* cmd : {run, simulate}) {
     cmd->add_option("SCENE", a.scene, "scene.toml, or a folder holding one")->required();
     cmd->add_option("--out", a.out,
-                    "output folder (default: the scene's [output] dir, else out/<scene name>)");
+                    "output folder (default: the scene's [output] dir, else out/<scene name>); "
+                    "one crumple writes into a folder at a time (DIR/.crumple.lock): another "
+                    "one writing there makes this exit 2");
     cmd->add_option(
         "--frames", a.frames,
         "A-B: simulate from the scene's first frame to B, render A-B (default: the scene's range)");
@@ -394,7 +396,10 @@ int main(int argc, char** argv) {
   render->add_option("CACHE", a.cache, "a .pcache file")->required();
   render->add_option("--frames", a.frames, "A-B: frames to render (default: every cached frame)");
   addRenderOptions(render, a);
-  render->add_option("--out", a.out, "frames folder (default: frames/ beside the cache)");
+  render->add_option("--out", a.out,
+                     "frames folder (default: frames/ beside the cache); locked while rendering "
+                     "(exit 2 when another crumple writes there), shared by renders of a "
+                     "--frames range (a farm's array tasks)");
   render
       ->add_option("--threads", a.threads,
                    "embree: worker threads (the images are identical for any count); osmesa: "
@@ -406,7 +411,9 @@ int main(int argc, char** argv) {
       "sounds from the events the simulation stored, heard from the camera; a WAV lasting "
       "exactly frame_count / fps, and its spectrogram PNG beside it.");
   soundCmd->add_option("CACHE", a.cache, "a .pcache file")->required();
-  soundCmd->add_option("--out", a.out, "the WAV file (default: sound.wav beside the cache)");
+  soundCmd->add_option("--out", a.out,
+                       "the WAV file (default: sound.wav beside the cache); its folder is locked "
+                       "while writing (exit 2 when another crumple writes there)");
   soundCmd
       ->add_option("--rate", a.rate, "sample rate: 48000 or 44100 (default: the scene's, 48000)")
       ->check(CLI::IsMember({48000, 44100}));
@@ -463,7 +470,9 @@ int main(int argc, char** argv) {
   exportCmd->add_option("CACHE", a.cache, "a .pcache file")->required();
   exportCmd->add_option("--format", a.exportFormat, "obj, ply, gltf or usda")->required();
   exportCmd->add_option("--out", a.out,
-                        "output folder (default: export/<format>/ beside the cache)");
+                        "output folder (default: export/<format>/ beside the cache); locked while "
+                        "writing (exit 2 when another crumple writes there), shared by exports "
+                        "of a --frames range");
   exportCmd->add_option("--frames", a.frames,
                         "A-B: frames to export (default: every cached frame)");
   auto* farm = app.add_subcommand("farm", "Run a shot on a render farm (docs/FARM.md).");

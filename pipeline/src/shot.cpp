@@ -31,6 +31,7 @@
 #include "crumple/pipeline/contacts.hpp"
 #include "crumple/pipeline/handle_rig.hpp"
 #include "crumple/pipeline/inspect.hpp"
+#include "crumple/pipeline/output_lock.hpp"
 #include "crumple/pipeline/sound.hpp"
 #include "crumple/render/osmesa_renderer.hpp"
 #include "crumple/sim/colliders.hpp"
@@ -513,6 +514,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   // The look travels in the cache (texture, mesh props), read and checked now.
   const std::vector<cache::ExtensionBlock> lookBlocks = lookHeaderBlocks(scene, animation.get());
   prepareOutputDir(report.outDir, "output");
+  const OutputLock outputLock(report.outDir);  // one writer per folder, until the shot is done
   report.cachePath = (fs::path(report.outDir) / "cache.pcache").string();
   if (animation)
     for (const auto& w : animation->warnings())
@@ -524,9 +526,11 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     for (const auto& w : report.warnings) std::fprintf(options.log, "warning: %s\n", w.c_str());
   report.summaryPath = (fs::path(report.outDir) / "summary.json").string();
   std::unique_ptr<detail::FrameRenderer> renderer;
+  std::optional<OutputLock> framesLock;
   if (render) {
     report.framesDir = (fs::path(report.outDir) / "frames").string();
     prepareOutputDir(report.framesDir, "frames");
+    framesLock.emplace(report.framesDir);
     renderer = std::make_unique<detail::FrameRenderer>(
         scene, lookBlocks, report.framesDir, options.debugStructure, options.rendering, seed);
     report.renderBackend = backendName(options.rendering.backend);
@@ -1211,6 +1215,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     SoundOptions soundOptions;
     soundOptions.log = options.log;
     soundOptions.interactive = options.interactive;
+    soundOptions.lockFolder = false;  // sound.wav goes beside the cache: outputLock's folder
     const SoundReport made = makeSound(report.cachePath, soundOptions);
     report.soundPath = made.wavPath;
     report.stages["sound"].totalMs += made.synthesisMs;
@@ -1266,6 +1271,8 @@ RenderReport renderCache(const std::string& cachePath, const RenderOptions& opti
   if ((options.rendering.contactSheet || options.rendering.movie) && !options.rendering.png)
     throw InputError("--contact-sheet/--movie", "need the PNG frames (drop --no-png)");
   prepareOutputDir(report.framesDir, "frames");
+  const OutputLock lock(report.framesDir,
+                        options.frames ? OutputLock::Mode::Shared : OutputLock::Mode::Exclusive);
   detail::FrameRenderer renderer(scene, header.extensions, report.framesDir, options.debugStructure,
                                  options.rendering, header.seed);
   Progress progress(std::string("crumple render (") + backendName(options.rendering.backend) + ")",

@@ -5,12 +5,14 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include "crumple/core/error.hpp"
 #include "crumple/core/progress.hpp"
 #include "crumple/exporters/pcache.hpp"
 #include "crumple/exporters/png.hpp"
+#include "crumple/pipeline/output_lock.hpp"
 #include "crumple/sound/database.hpp"
 #include "crumple/sound/soundtrack.hpp"
 #include "crumple/sound/spectrogram.hpp"
@@ -121,6 +123,8 @@ SoundReport makeSound(const std::string& cachePath, const SoundOptions& options)
                        : (fs::path(cachePath).parent_path() / "sound.wav").string();
   if (options.gainDb && !std::isfinite(*options.gainDb))
     throw InputError("--gain-db", "must be a finite number of dB");
+  std::optional<OutputLock> lock;
+  if (options.lockFolder) lock.emplace(fs::path(report.wavPath).parent_path().string());
 
   const sound::SoundDatabase db =
       sound::SoundDatabase::load(report.databasePath).resampledTo(report.sampleRate);

@@ -178,15 +178,19 @@ const char* tearKindName(tear::CandidateKind kind);
 mesh::SheetMesh buildSheet(const io::SceneSpec& scene, const io::AnimationScene* animation);
 
 // Simulates the shot and writes DIR/cache.pcache (and, with options.render,
-// DIR/frames/NNNN.png), then DIR/summary.json. Bad input throws InputError
-// before anything is written. A numerical failure closes the cache at the
-// last good frame, writes the summary with the error, and throws
-// NumericalError naming the frame and stage.
+// DIR/frames/NNNN.png), then DIR/summary.json, holding DIR's lock (and
+// DIR/frames') throughout (OutputLock). Bad input, or a folder another
+// crumple is writing into, throws InputError before anything is written. A
+// numerical failure closes the cache at the last good frame, writes the
+// summary with the error, and throws NumericalError naming the frame and
+// stage.
 ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options);
 
 // Renders frames of a cache with the chosen backend into framesDir
 // (NNNN.png and/or NNNN.exr, each written atomically), then the contact sheet
-// and the movie when asked. Returns the frames written.
+// and the movie when asked. Returns the frames written. Holds framesDir's
+// lock (OutputLock): exclusive for the whole cache, shared for a frame range
+// (a farm's array tasks render their chunks into one folder side by side).
 struct RenderOptions {
   std::optional<FrameRange> frames;  // default: all cached frames
   std::string framesDir;             // default: <cache folder>/frames
