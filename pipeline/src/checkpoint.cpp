@@ -17,21 +17,52 @@
 namespace crumple::pipeline {
 namespace {
 
-constexpr std::uint32_t kCheckpointVersion = 5;
+constexpr std::uint32_t kCheckpointVersion = 6;
 constexpr char kMagic[9] = "CRUMPCKP";
 
-std::uint32_t sceneHash(const io::SceneSpec& scene) {
-  return crc32(scene.sourceText.data(), scene.sourceText.size());
+std::uint64_t sceneHash(const io::SceneSpec& scene) {
+  return fnv1a64(scene.sourceText.data(), scene.sourceText.size());
+}
+
+// Checks the inputs a checkpoint recorded against the shot's now: the same
+// files (by their part in the shot), each with the same size and hash.
+void checkInputs(StateReader& r, const std::string& path, const std::vector<ShotInput>& now) {
+  const std::size_t n = r.count(8 + 8 + 8 + 8);
+  bool sameFiles = n == now.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::string what = r.str();
+    (void)r.str();  // the path it had then: the file may have moved since, its bytes count
+    const std::uint64_t size = r.u64(), hash = r.u64();
+    if (k >= now.size() || now[k].what != what) {
+      sameFiles = false;
+      continue;
+    }
+    if (size != now[k].size || hash != now[k].hash)
+      throw InputError(path, what + " " + now[k].path +
+                                 " changed since the checkpoint was written: cannot resume");
+  }
+  if (!sameFiles)
+    throw InputError(path, "the files the scene reads changed since the checkpoint was written (" +
+                               std::to_string(n) + " then, " + std::to_string(now.size()) +
+                               " now): cannot resume");
 }
 
 }  // namespace
 
-void writeCheckpointHead(StateWriter& w, const io::SceneSpec& scene, std::uint64_t seed,
-                         int lastFrame, int frame, std::size_t cachedFrames) {
+void writeCheckpointHead(StateWriter& w, const io::SceneSpec& scene,
+                         const std::vector<ShotInput>& inputs, std::uint64_t seed, int lastFrame,
+                         int frame, std::size_t cachedFrames) {
   w.tag("CKPT");
   w.u32(kCheckpointVersion);
-  w.u32(sceneHash(scene));
+  w.u64(sceneHash(scene));
   w.u64(scene.sourceText.size());
+  w.count(inputs.size());
+  for (const ShotInput& input : inputs) {
+    w.str(input.what);
+    w.str(input.path);
+    w.u64(input.size);
+    w.u64(input.hash);
+  }
   w.u64(seed);
   w.i32(scene.frameStart);
   w.i32(lastFrame);
@@ -61,8 +92,8 @@ void writeCheckpointFile(const std::string& path, const StateWriter& w) {
   if (ec) throw InputError(path, "cannot write the checkpoint: " + ec.message());
 }
 
-Checkpoint readCheckpoint(const std::string& path, const io::SceneSpec& scene, std::uint64_t seed,
-                          int lastFrame) {
+Checkpoint readCheckpoint(const std::string& path, const io::SceneSpec& scene,
+                          const std::vector<ShotInput>& inputs, std::uint64_t seed, int lastFrame) {
   std::ifstream in(path, std::ios::binary);
   if (!in)
     throw InputError(path, "no checkpoint to resume from (run with --checkpoint-every N first)");
@@ -85,11 +116,12 @@ Checkpoint readCheckpoint(const std::string& path, const io::SceneSpec& scene, s
     if (const auto v = r.u32(); v != kCheckpointVersion)
       throw InputError(path, std::string("checkpoint version ") + std::to_string(v) +
                                  ", this crumple reads " + std::to_string(kCheckpointVersion));
-    const std::uint32_t hash = r.u32();
+    const std::uint64_t hash = r.u64();
     const std::uint64_t length = r.u64();
     if (hash != sceneHash(scene) || length != scene.sourceText.size())
       throw InputError(path, "belongs to another scene (" + scene.file +
                                  " changed since it was written): cannot resume");
+    checkInputs(r, path, inputs);
     if (r.u64() != seed) throw InputError(path, "was written with another seed: cannot resume");
     const int first = r.i32(), last = r.i32();
     if (first != scene.frameStart || last != lastFrame)

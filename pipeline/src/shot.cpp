@@ -476,6 +476,9 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     animation = std::make_unique<io::AnimationScene>(io::AnimationScene::load(scene.animationFile));
     io::checkAnimationNodes(scene, *animation);
   }
+  // What a checkpoint records of the files read (docs/CHECKPOINT.md), hashed as they were read.
+  const std::vector<ShotInput> inputs =
+      options.checkpointEvery > 0 || options.resume ? shotInputs(scene) : std::vector<ShotInput>{};
   const double t0 = frameTime(scene, scene.frameStart);
   const bool hybridModel = scene.model.type == io::ModelSpec::Type::Hybrid;
   sim::SimParams params;
@@ -597,7 +600,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   // how many cached frames go with it; the cache keeps those and goes on.
   const std::string checkpointPath = (fs::path(report.outDir) / kCheckpointFile).string();
   std::optional<Checkpoint> resumed;
-  if (options.resume) resumed = readCheckpoint(checkpointPath, scene, seed, range.last);
+  if (options.resume) resumed = readCheckpoint(checkpointPath, scene, inputs, seed, range.last);
   std::unique_ptr<cache::CacheWriter> writer =
       resumed ? cache::CacheWriter::resume(report.cachePath, header, resumed->cachedFrames)
               : std::make_unique<cache::CacheWriter>(report.cachePath, header);
@@ -1042,7 +1045,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   const auto checkpoint = [&](int frame) {
     const auto start = Clock::now();
     StateWriter w;
-    writeCheckpointHead(w, scene, seed, range.last, frame, writer->framesWritten());
+    writeCheckpointHead(w, scene, inputs, seed, range.last, frame, writer->framesWritten());
     saveReport(w, report);
     // The model: the crumpling model's layers, or the elastic model on its
     // (possibly torn) mesh.

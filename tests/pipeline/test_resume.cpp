@@ -1,0 +1,118 @@
+// What a resume refuses: `--resume` after any file that shapes the shot
+// changed (the animation file and the buffers it names, the paper preset,
+// the texture) is exit 2 naming the file.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "crumple/exporters/png.hpp"
+#include "crumple/io/scene.hpp"
+#include "test_util.hpp"
+
+using namespace crumple;
+using namespace crumple::testing;
+
+namespace {
+
+std::vector<std::uint8_t> fromBase64(const std::string& text) {
+  std::vector<std::uint8_t> out;
+  std::uint32_t bits = 0;
+  int count = 0;
+  for (const char c : text) {
+    const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    const char* at = std::strchr(table, c);
+    if (c == '=' || c == '\0' || at == nullptr) break;
+    bits = (bits << 6) | static_cast<std::uint32_t>(at - table);
+    if ((count += 6) >= 8) {
+      count -= 8;
+      out.push_back(static_cast<std::uint8_t>(bits >> count));
+    }
+  }
+  return out;
+}
+
+// The small scene (test_util.hpp) with its buffer in anim.bin beside
+// anim.gltf, and a printed texture.
+void writeSceneWithFiles(const fs::path& dir, std::uint8_t shade) {
+  writeSmallScene(dir);
+  std::string gltf = readFile(dir / "anim.gltf");
+  const std::string prefix = "data:application/octet-stream;base64,";
+  const auto from = gltf.find(prefix);
+  const auto to = gltf.find('"', from);
+  ASSERT_NE(from, std::string::npos);
+  const auto blob = fromBase64(gltf.substr(from + prefix.size(), to - from - prefix.size()));
+  writeFile(dir / "anim.bin", std::string(blob.begin(), blob.end()));
+  gltf.replace(from, to - from, "anim.bin");
+  writeFile(dir / "anim.gltf", gltf);
+  ImageRGBA8 tex(8, 8);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) {
+      std::uint8_t* p = tex.at(x, y);
+      p[0] = shade;
+      p[1] = static_cast<std::uint8_t>(30 * x);
+      p[2] = static_cast<std::uint8_t>(30 * y);
+      p[3] = 255;
+    }
+  exporters::writePng((dir / "print.png").string(), tex);
+  std::string scene = readFile(dir / "scene.toml");
+  scene.replace(scene.find("[paper]\n"), 8, "[paper]\ntexture = \"print.png\"\n");
+  writeFile(dir / "scene.toml", scene);
+}
+
+}  // namespace
+
+TEST(Resume, AChangedInputIsRefusedNamingIt) {
+  const TempDir tmp;
+  const fs::path dir = tmp / "scene";
+  writeSceneWithFiles(dir, 200);
+  // The paper preset from a folder of this test's ($CRUMPLE_ASSETS/papers).
+  fs::create_directories(tmp / "assets/papers");
+  fs::copy_file(sourcePath("assets/papers/office-70gsm.toml"),
+                tmp / "assets/papers/office-70gsm.toml");
+  const fs::path preset = tmp / "assets/papers/office-70gsm.toml";
+  const std::string simulate = "env CRUMPLE_ASSETS=" + (tmp / "assets").string() + " " +
+                               CRUMPLE_BIN + " simulate " + dir.string() + " --out " +
+                               (tmp / "out").string() + " --checkpoint-every 2";
+  const auto whole = runCommand(simulate);
+  ASSERT_EQ(whole.status, 0) << whole.output;
+  const std::string cache = readFile(tmp / "out/cache.pcache");
+
+  // Each file changed in turn: refused, naming it; put back, the next one.
+  const auto expectRefused = [&](const fs::path& file, const std::string& what) {
+    const auto r = runCommand(simulate + " --resume");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find(what + " "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(file.filename().string() +
+                            " changed since the checkpoint was written: cannot resume"),
+              std::string::npos)
+        << r.output;
+  };
+  for (const auto& [name, what] : {std::pair{"anim.gltf", "the animation file"},
+                                   std::pair{"anim.bin", "the file the animation file names"}}) {
+    const std::string original = readFile(dir / name);
+    std::string changed = original;
+    if (std::string(name) == "anim.gltf")
+      changed += "\n";  // the same animation, other bytes
+    else
+      changed[0] = static_cast<char>(changed[0] ^ 1);  // the first key's time, 0 -> 1e-45 s
+    writeFile(dir / name, changed);
+    expectRefused(dir / name, what);
+    writeFile(dir / name, original);
+  }
+  const std::string presetText = readFile(preset);
+  writeFile(preset, presetText + "# edited\n");
+  expectRefused(preset, "the paper preset");
+  writeFile(preset, presetText);
+  const std::string texture = readFile(dir / "print.png");
+  writeSceneWithFiles(dir, 100);  // the same scene, another texture
+  expectRefused(dir / "print.png", "the paper texture");
+  writeFile(dir / "print.png", texture);
+
+  // Everything as it was: it resumes, to the same bytes.
+  const auto r = runCommand(simulate + " --resume");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("resuming after frame 5"), std::string::npos) << r.output;
+  EXPECT_EQ(readFile(tmp / "out/cache.pcache"), cache);
+}
