@@ -142,6 +142,12 @@ Checkpoint readCheckpoint(const std::string& path, const io::SceneSpec& scene,
 void saveReport(StateWriter& w, const ShotReport& r) {
   w.tag("REPT");
   w.i32(r.framesSimulated);
+  w.i32(r.framesRendered);
+  w.i64(static_cast<std::int64_t>(r.vertices));
+  w.i64(static_cast<std::int64_t>(r.triangles));
+  w.i64(static_cast<std::int64_t>(r.maxTriangles));
+  w.i32(r.singularVertices);
+  w.i32(r.interiorSingularVertices);
   w.i64(r.newtonIterations);
   w.i64(r.substeps);
   w.i64(r.halvings);
@@ -183,11 +189,32 @@ void saveReport(StateWriter& w, const ShotReport& r) {
     w.f64(cost.totalMs);
     w.i64(cost.frames);
   }
+  for (const auto& span : {r.newtonRetried, r.selfContactDropped}) {
+    w.i32(span.first);
+    w.i32(span.last);
+  }
+  w.count(r.beyondReach.size());
+  for (const auto& [handle, span] : r.beyondReach) {
+    w.i64(static_cast<std::int64_t>(handle));
+    w.i32(span.first);
+    w.i32(span.last);
+    w.f64(span.most);
+  }
 }
 
-void restoreReport(StateReader& in, ShotReport& r) {
+void restoreReport(StateReader& in, ShotReport& r, std::size_t handles) {
   in.tag("REPT");
   r.framesSimulated = in.i32();
+  r.framesRendered = in.i32();
+  const std::int64_t vertices = in.i64(), triangles = in.i64(), maxTriangles = in.i64();
+  if (r.framesSimulated < 0 || r.framesRendered < 0 || vertices < 0 || triangles < 0 ||
+      maxTriangles < 0)
+    in.fail("the frame or mesh counts are out of range");
+  r.vertices = static_cast<std::size_t>(vertices);
+  r.triangles = static_cast<std::size_t>(triangles);
+  r.maxTriangles = static_cast<std::size_t>(maxTriangles);
+  r.singularVertices = in.i32();
+  r.interiorSingularVertices = in.i32();
   r.newtonIterations = in.i64();
   r.substeps = in.i64();
   r.halvings = in.i64();
@@ -235,6 +262,24 @@ void restoreReport(StateReader& in, ShotReport& r) {
     c.totalMs = in.f64();
     c.frames = in.i64();
   }
+  for (ShotReport::FrameSpan* span : {&r.newtonRetried, &r.selfContactDropped}) {
+    span->first = in.i32();
+    span->last = in.i32();
+    if (span->last < span->first) in.fail("a frame span of the warnings is out of range");
+  }
+  r.beyondReach.clear();
+  const std::size_t reaches = in.count(8 + 4 + 4 + 8);
+  for (std::size_t k = 0; k < reaches; ++k) {
+    const std::int64_t handle = in.i64();
+    ShotReport::BeyondReach span;
+    span.first = in.i32();
+    span.last = in.i32();
+    span.most = in.f64();
+    if (handle < 0 || handle >= static_cast<std::int64_t>(handles) || span.last < span.first ||
+        !(span.most >= 0.0) || !std::isfinite(span.most))
+      in.fail("a handle's beyond-reach record is out of range");
+    r.beyondReach[static_cast<std::size_t>(handle)] = span;
+  }
 }
 
 void saveTearingReport(StateWriter& w, const ShotReport& r) {
@@ -259,8 +304,6 @@ void saveTearingReport(StateWriter& w, const ShotReport& r) {
   w.i32(r.tearRegionsFlattened);
   w.f64(r.tearMs);
   w.f64(r.tearBakeMs);
-  w.i64(static_cast<std::int64_t>(r.maxTriangles));
-  w.i64(static_cast<std::int64_t>(r.vertices));
   w.count(r.notes.size());
   for (const auto& n : r.notes) w.str(n);
 }
@@ -290,8 +333,6 @@ void restoreTearingReport(StateReader& in, ShotReport& r) {
   r.tearRegionsFlattened = in.i32();
   r.tearMs = in.f64();
   r.tearBakeMs = in.f64();
-  r.maxTriangles = static_cast<std::size_t>(in.i64());
-  r.vertices = static_cast<std::size_t>(in.i64());
   r.notes.resize(in.count(8));
   for (auto& n : r.notes) n = in.str();
 }

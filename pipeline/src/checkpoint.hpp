@@ -40,10 +40,13 @@ void writeCheckpointFile(const std::string& path, const StateWriter& w);
 Checkpoint readCheckpoint(const std::string& path, const io::SceneSpec& scene,
                           const std::vector<ShotInput>& inputs, std::uint64_t seed, int lastFrame);
 
-// The report's running counters, so that a resumed run's summary counts the
-// whole shot.
+// The report's running counters and records (everything summary.json says
+// about the frames simulated so far), so that a resumed run's summary is the
+// uninterrupted run's.
 void saveReport(StateWriter& w, const ShotReport& r);
-void restoreReport(StateReader& in, ShotReport& r);
+// `handles`: the scene's handle count, which the records' handle indices
+// are checked against.
+void restoreReport(StateReader& in, ShotReport& r, std::size_t handles);
 // Its tearing part: every advance (the hand-over replays them, the sound
 // events read the frame's), the tears' frames and counts, and the notes.
 void saveTearingReport(StateWriter& w, const ShotReport& r);

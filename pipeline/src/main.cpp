@@ -381,9 +381,9 @@ int main(int argc, char** argv) {
                     "(atomically)")
         ->check(CLI::Range(1, 1 << 30));
     cmd->add_flag("--resume", a.resume,
-                  "go on from DIR/checkpoint.bin after an interruption: the cache ends "
-                  "byte-identical to an uninterrupted run's; exit 2 when the scene file, its "
-                  "animation file, paper preset or texture changed since");
+                  "go on from DIR/checkpoint.bin after an interruption: the cache and the "
+                  "summary end as an uninterrupted run's (the cache byte-identical); exit 2 when "
+                  "the scene file, its animation file, paper preset or texture changed since");
   }
   addRenderOptions(run, a);
   run->add_flag(

@@ -16,7 +16,6 @@
 #include <numbers>
 #include <optional>
 #include <string_view>
-#include <tuple>
 
 #include "checkpoint.hpp"
 #include "crumple/core/error.hpp"
@@ -628,30 +627,25 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   // The crumpling model's structure changes of the frame being emitted.
   std::optional<cache::ExtensionBlock> structureBlock;
   mesh::SheetMesh bakedSheet;  // the triangles and pattern tearAtlasBlock refers to
-  // Per handle pulled beyond the sheet's reach: first and last frame, most (m).
-  std::map<std::size_t, std::tuple<int, int, double>> beyondReach;
-  // Frames whose elastic step needed more Newton iterations, or went on
-  // without self-contact, after failing at every halving (first, last).
-  std::pair<int, int> newtonRetried{-1, -1}, selfContactDropped{-1, -1};
   const auto noteRecovery = [&](const sim::StepStats& stats, int frame) {
-    for (auto [happened, span] : {std::pair{stats.newtonRetried, &newtonRetried},
-                                  std::pair{stats.selfContactDropped, &selfContactDropped}})
+    for (auto [happened, span] : {std::pair{stats.newtonRetried, &report.newtonRetried},
+                                  std::pair{stats.selfContactDropped, &report.selfContactDropped}})
       if (happened > 0) {
         if (span->first < 0) span->first = frame;
-        span->second = frame;
+        span->last = frame;
       }
   };
   const auto stabilityWarnings = [&] {
-    if (newtonRetried.first >= 0)
-      report.warnings.push_back(
-          "the elastic solve needed " + std::to_string(sim::kRetryIterationFactor) +
-          " times [sim] max_newton_iterations at frames " + std::to_string(newtonRetried.first) +
-          "-" + std::to_string(newtonRetried.second));
-    if (selfContactDropped.first >= 0)
+    if (const auto& span = report.newtonRetried; span.first >= 0)
+      report.warnings.push_back("the elastic solve needed " +
+                                std::to_string(sim::kRetryIterationFactor) +
+                                " times [sim] max_newton_iterations at frames " +
+                                std::to_string(span.first) + "-" + std::to_string(span.last));
+    if (const auto& span = report.selfContactDropped; span.first >= 0)
       report.warnings.push_back(
           "the elastic solve failed with self-contact and went on without it at frames " +
-          std::to_string(selfContactDropped.first) + "-" +
-          std::to_string(selfContactDropped.second) + ": the sheet may pass through itself there");
+          std::to_string(span.first) + "-" + std::to_string(span.last) +
+          ": the sheet may pass through itself there");
     if (report.elasticHeldStill > 0)
       report.warnings.push_back(
           "the self-contact guard held the whole sheet still on " +
@@ -671,13 +665,12 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
                     report.elasticHeldStill > 0 ? " or passing through itself" : "");
       report.warnings.push_back(text);
     }
-    for (const auto& [h, span] : beyondReach) {
+    for (const auto& [h, span] : report.beyondReach) {
       char text[320];
       std::snprintf(text, sizeof text,
                     "handle '%s' is pulled beyond the sheet's reach at frames %d-%d (up to %.3g m "
                     "past it): it stops on the reach and lags behind its node there",
-                    rig.handles()[h].name.c_str(), std::get<0>(span), std::get<1>(span),
-                    std::get<2>(span));
+                    rig.handles()[h].name.c_str(), span.first, span.last, span.most);
       report.warnings.push_back(text);
     }
   };
@@ -732,10 +725,10 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
       record.handleTargets.push_back(rig.target(h, t));
       // A node beyond the sheet's reach (issue 9): the handle lags behind it.
       if (const double excess = rig.reachExcess(h, t); excess > 0.0) {
-        auto& [first, last, most] = beyondReach.try_emplace(h, -1, -1, 0.0).first->second;
-        if (first < 0) first = frame;
-        last = frame;
-        most = std::max(most, excess);
+        ShotReport::BeyondReach& span = report.beyondReach[h];
+        if (span.first < 0) span.first = frame;
+        span.last = frame;
+        span.most = std::max(span.most, excess);
       }
     }
     record.camera = cameraAt(scene, animation.get(), t);
@@ -1078,7 +1071,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   int firstFrame = scene.frameStart + 1;
   if (resumed) {
     StateReader& in = *resumed->state;
-    restoreReport(in, report);
+    restoreReport(in, report, rig.handles().size());
     if (in.boolean()) {
       if (!hybrid) in.fail("holds the crumpling model's state, the scene runs the elastic model");
       hybrid->restoreState(in);

@@ -1,14 +1,19 @@
-// What a resume refuses: `--resume` after any file that shapes the shot
-// changed (the animation file and the buffers it names, the paper preset,
-// the texture) is exit 2 naming the file.
+// What a resume keeps and what it refuses: `--resume` after any file that
+// shapes the shot changed (the animation file and the buffers it names, the
+// paper preset, the texture) is exit 2 naming the file; a resumed run's
+// summary.json is the uninterrupted run's (but for its timings), on the
+// elastic and on the crumpling model.
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <optional>
+#include <regex>
 #include <string>
 #include <vector>
 
 #include "crumple/exporters/png.hpp"
 #include "crumple/io/scene.hpp"
+#include "crumple/pipeline/shot.hpp"
 #include "test_util.hpp"
 
 using namespace crumple;
@@ -59,6 +64,58 @@ void writeSceneWithFiles(const fs::path& dir, std::uint8_t shade) {
   std::string scene = readFile(dir / "scene.toml");
   scene.replace(scene.find("[paper]\n"), 8, "[paper]\ntexture = \"print.png\"\n");
   writeFile(dir / "scene.toml", scene);
+}
+
+// summary.json without what the clock decides: every ms_per_frame (and
+// the stages' object of them) and the contacts' share of the step.
+std::string modelFields(const std::string& json) {
+  static const std::regex timing(R"re("(\w*ms_per_frame|share_of_step)":(\{[^}]*\}|[^,}]*))re");
+  return std::regex_replace(json, timing, "\"$1\":-");
+}
+
+pipeline::ShotOptions options(const fs::path& out, bool render) {
+  pipeline::ShotOptions o;
+  o.outDir = out.string();
+  o.render = render;
+  o.log = nullptr;
+  o.interactive = 0;
+  return o;
+}
+
+// Runs the shot whole with a checkpoint every `every` frames, then resumes
+// it from its last checkpoint (the frames after it simulated again); expects
+// the same cache and the same summary (but for timings) both times.
+void expectResumedSummaryIsTheWholeOne(const io::SceneSpec& scene, const fs::path& out, int every,
+                                       bool render,
+                                       std::optional<pipeline::FrameRange> frames = {}) {
+  pipeline::ShotOptions o = options(out, render);
+  o.frames = frames;
+  o.checkpointEvery = every;
+  (void)pipeline::runShot(scene, o);
+  const std::string whole = readFile(out / "summary.json");
+  const std::string cache = readFile(out / "cache.pcache");
+  ASSERT_FALSE(whole.empty());
+  o.checkpointEvery = 0;
+  o.resume = true;
+  (void)pipeline::runShot(scene, o);
+  const std::string resumed = readFile(out / "summary.json");
+  EXPECT_EQ(readFile(out / "cache.pcache"), cache);
+  EXPECT_EQ(modelFields(resumed), modelFields(whole)) << "checkpoint every " << every;
+}
+
+// The crumpling model's shot of the resume test: samples/crumple to frame
+// 45, whole, and resumed from its checkpoints every `every` frames. S_P has
+// its most triangles (112) at the start and 60-71 from frame 9 on; singular
+// vertices appear from frame 12, the handles lag from frame 33 and the
+// whole sheet is held still on frames 36-45 (warnings with their frames).
+void expectCrumplingResumeKeepsTheSummary(int every) {
+  const TempDir tmp;
+  const auto scene = io::loadScene(io::resolveScenePath(sourcePath("samples/crumple")));
+  const pipeline::FrameRange frames{scene.frameStart, 45};
+  expectResumedSummaryIsTheWholeOne(scene, tmp / "out", every, false, frames);
+  const std::string summary = readFile(tmp / "out/summary.json");
+  EXPECT_NE(summary.find("\"max_triangles\":112"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("lags behind its node"), std::string::npos) << summary;
 }
 
 }  // namespace
@@ -115,4 +172,36 @@ TEST(Resume, AChangedInputIsRefusedNamingIt) {
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("resuming after frame 5"), std::string::npos) << r.output;
   EXPECT_EQ(readFile(tmp / "out/cache.pcache"), cache);
+}
+
+TEST(Resume, TheElasticModelsSummaryIsTheUninterruptedRuns) {
+  // The small scene with a handle that jumps beyond the sheet's reach at
+  // frame 3 (a warning with its frames), rendered: resumed after frame 5
+  // (checkpoint every 4), then after frame 6 (the last: nothing left to do).
+  const TempDir tmp;
+  writeSmallScene(tmp / "s");
+  const GltfTrack a{"A",
+                    {0.0f, 0.1f, 0.125f},
+                    {{-0.05f, 0.2f, 0.0f}, {-0.05f, 0.2f, 0.0f}, {-0.05f, 1e4f, 0.0f}}};
+  const GltfTrack b{"B", {}, {{0.05f, 0.2f, 0.0f}}};
+  writeFile(tmp / "s/anim.gltf", makeGltf({a, b}));
+  const auto scene = io::loadScene((tmp / "s/scene.toml").string());
+  for (const int every : {4, 5}) {
+    expectResumedSummaryIsTheWholeOne(scene, tmp / "out", every, true);
+    const std::string summary = readFile(tmp / "out/summary.json");
+    EXPECT_NE(summary.find("\"frames_rendered\":6"), std::string::npos) << summary;
+    EXPECT_NE(summary.find("pulled beyond the sheet's reach at frames 3-6"), std::string::npos)
+        << summary;
+  }
+}
+
+// Resumed after frame 36: the lags and the held-still steps run across it.
+TEST(Resume, TheCrumplingModelsSummaryIsTheUninterruptedRuns) {
+  expectCrumplingResumeKeepsTheSummary(36);
+}
+
+// The same shot resumed from its checkpoint of the last frame: nothing is
+// simulated again, the summary still counts the whole shot.
+TEST(Resume, ACrumplingModelResumedAtItsLastFrameKeepsTheSummary) {
+  expectCrumplingResumeKeepsTheSummary(45);
 }

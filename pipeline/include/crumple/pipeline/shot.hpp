@@ -107,6 +107,19 @@ struct ShotReport {
     int maxFrame = -1;
   };
   std::vector<HandleLag> handleLags;
+  // Frames whose elastic step needed more Newton iterations, or went on
+  // without self-contact, after failing at every halving (first and last
+  // frame, -1: none), and each handle (by index) pulled beyond the sheet's
+  // reach (first and last frame, the most in metres): the warnings' record.
+  struct FrameSpan {
+    int first = -1, last = -1;
+  };
+  FrameSpan newtonRetried, selfContactDropped;
+  struct BeyondReach {
+    int first = -1, last = -1;
+    double most = 0.0;
+  };
+  std::map<std::size_t, BeyondReach> beyondReach;
   // Contacts (issue 5): collider and self-contact work (detection, the
   // failsafe; within the elastic stage, plus the crumpling model's failsafe
   // after its isometry), the deepest free vertex inside a collider or the
