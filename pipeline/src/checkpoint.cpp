@@ -17,21 +17,52 @@
 namespace crumple::pipeline {
 namespace {
 
-constexpr std::uint32_t kCheckpointVersion = 5;
+constexpr std::uint32_t kCheckpointVersion = 6;
 constexpr char kMagic[9] = "CRUMPCKP";
 
-std::uint32_t sceneHash(const io::SceneSpec& scene) {
-  return crc32(scene.sourceText.data(), scene.sourceText.size());
+std::uint64_t sceneHash(const io::SceneSpec& scene) {
+  return fnv1a64(scene.sourceText.data(), scene.sourceText.size());
+}
+
+// Checks the inputs a checkpoint recorded against the shot's now: the same
+// files (by their part in the shot), each with the same size and hash.
+void checkInputs(StateReader& r, const std::string& path, const std::vector<ShotInput>& now) {
+  const std::size_t n = r.count(8 + 8 + 8 + 8);
+  bool sameFiles = n == now.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::string what = r.str();
+    (void)r.str();  // the path it had then: the file may have moved since, its bytes count
+    const std::uint64_t size = r.u64(), hash = r.u64();
+    if (k >= now.size() || now[k].what != what) {
+      sameFiles = false;
+      continue;
+    }
+    if (size != now[k].size || hash != now[k].hash)
+      throw InputError(path, what + " " + now[k].path +
+                                 " changed since the checkpoint was written: cannot resume");
+  }
+  if (!sameFiles)
+    throw InputError(path, "the files the scene reads changed since the checkpoint was written (" +
+                               std::to_string(n) + " then, " + std::to_string(now.size()) +
+                               " now): cannot resume");
 }
 
 }  // namespace
 
-void writeCheckpointHead(StateWriter& w, const io::SceneSpec& scene, std::uint64_t seed,
-                         int lastFrame, int frame, std::size_t cachedFrames) {
+void writeCheckpointHead(StateWriter& w, const io::SceneSpec& scene,
+                         const std::vector<ShotInput>& inputs, std::uint64_t seed, int lastFrame,
+                         int frame, std::size_t cachedFrames) {
   w.tag("CKPT");
   w.u32(kCheckpointVersion);
-  w.u32(sceneHash(scene));
+  w.u64(sceneHash(scene));
   w.u64(scene.sourceText.size());
+  w.count(inputs.size());
+  for (const ShotInput& input : inputs) {
+    w.str(input.what);
+    w.str(input.path);
+    w.u64(input.size);
+    w.u64(input.hash);
+  }
   w.u64(seed);
   w.i32(scene.frameStart);
   w.i32(lastFrame);
@@ -61,8 +92,8 @@ void writeCheckpointFile(const std::string& path, const StateWriter& w) {
   if (ec) throw InputError(path, "cannot write the checkpoint: " + ec.message());
 }
 
-Checkpoint readCheckpoint(const std::string& path, const io::SceneSpec& scene, std::uint64_t seed,
-                          int lastFrame) {
+Checkpoint readCheckpoint(const std::string& path, const io::SceneSpec& scene,
+                          const std::vector<ShotInput>& inputs, std::uint64_t seed, int lastFrame) {
   std::ifstream in(path, std::ios::binary);
   if (!in)
     throw InputError(path, "no checkpoint to resume from (run with --checkpoint-every N first)");
@@ -85,11 +116,12 @@ Checkpoint readCheckpoint(const std::string& path, const io::SceneSpec& scene, s
     if (const auto v = r.u32(); v != kCheckpointVersion)
       throw InputError(path, std::string("checkpoint version ") + std::to_string(v) +
                                  ", this crumple reads " + std::to_string(kCheckpointVersion));
-    const std::uint32_t hash = r.u32();
+    const std::uint64_t hash = r.u64();
     const std::uint64_t length = r.u64();
     if (hash != sceneHash(scene) || length != scene.sourceText.size())
       throw InputError(path, "belongs to another scene (" + scene.file +
                                  " changed since it was written): cannot resume");
+    checkInputs(r, path, inputs);
     if (r.u64() != seed) throw InputError(path, "was written with another seed: cannot resume");
     const int first = r.i32(), last = r.i32();
     if (first != scene.frameStart || last != lastFrame)
@@ -110,6 +142,12 @@ Checkpoint readCheckpoint(const std::string& path, const io::SceneSpec& scene, s
 void saveReport(StateWriter& w, const ShotReport& r) {
   w.tag("REPT");
   w.i32(r.framesSimulated);
+  w.i32(r.framesRendered);
+  w.i64(static_cast<std::int64_t>(r.vertices));
+  w.i64(static_cast<std::int64_t>(r.triangles));
+  w.i64(static_cast<std::int64_t>(r.maxTriangles));
+  w.i32(r.singularVertices);
+  w.i32(r.interiorSingularVertices);
   w.i64(r.newtonIterations);
   w.i64(r.substeps);
   w.i64(r.halvings);
@@ -151,11 +189,32 @@ void saveReport(StateWriter& w, const ShotReport& r) {
     w.f64(cost.totalMs);
     w.i64(cost.frames);
   }
+  for (const auto& span : {r.newtonRetried, r.selfContactDropped}) {
+    w.i32(span.first);
+    w.i32(span.last);
+  }
+  w.count(r.beyondReach.size());
+  for (const auto& [handle, span] : r.beyondReach) {
+    w.i64(static_cast<std::int64_t>(handle));
+    w.i32(span.first);
+    w.i32(span.last);
+    w.f64(span.most);
+  }
 }
 
-void restoreReport(StateReader& in, ShotReport& r) {
+void restoreReport(StateReader& in, ShotReport& r, std::size_t handles) {
   in.tag("REPT");
   r.framesSimulated = in.i32();
+  r.framesRendered = in.i32();
+  const std::int64_t vertices = in.i64(), triangles = in.i64(), maxTriangles = in.i64();
+  if (r.framesSimulated < 0 || r.framesRendered < 0 || vertices < 0 || triangles < 0 ||
+      maxTriangles < 0)
+    in.fail("the frame or mesh counts are out of range");
+  r.vertices = static_cast<std::size_t>(vertices);
+  r.triangles = static_cast<std::size_t>(triangles);
+  r.maxTriangles = static_cast<std::size_t>(maxTriangles);
+  r.singularVertices = in.i32();
+  r.interiorSingularVertices = in.i32();
   r.newtonIterations = in.i64();
   r.substeps = in.i64();
   r.halvings = in.i64();
@@ -203,6 +262,24 @@ void restoreReport(StateReader& in, ShotReport& r) {
     c.totalMs = in.f64();
     c.frames = in.i64();
   }
+  for (ShotReport::FrameSpan* span : {&r.newtonRetried, &r.selfContactDropped}) {
+    span->first = in.i32();
+    span->last = in.i32();
+    if (span->last < span->first) in.fail("a frame span of the warnings is out of range");
+  }
+  r.beyondReach.clear();
+  const std::size_t reaches = in.count(8 + 4 + 4 + 8);
+  for (std::size_t k = 0; k < reaches; ++k) {
+    const std::int64_t handle = in.i64();
+    ShotReport::BeyondReach span;
+    span.first = in.i32();
+    span.last = in.i32();
+    span.most = in.f64();
+    if (handle < 0 || handle >= static_cast<std::int64_t>(handles) || span.last < span.first ||
+        !(span.most >= 0.0) || !std::isfinite(span.most))
+      in.fail("a handle's beyond-reach record is out of range");
+    r.beyondReach[static_cast<std::size_t>(handle)] = span;
+  }
 }
 
 void saveTearingReport(StateWriter& w, const ShotReport& r) {
@@ -227,8 +304,6 @@ void saveTearingReport(StateWriter& w, const ShotReport& r) {
   w.i32(r.tearRegionsFlattened);
   w.f64(r.tearMs);
   w.f64(r.tearBakeMs);
-  w.i64(static_cast<std::int64_t>(r.maxTriangles));
-  w.i64(static_cast<std::int64_t>(r.vertices));
   w.count(r.notes.size());
   for (const auto& n : r.notes) w.str(n);
 }
@@ -258,8 +333,6 @@ void restoreTearingReport(StateReader& in, ShotReport& r) {
   r.tearRegionsFlattened = in.i32();
   r.tearMs = in.f64();
   r.tearBakeMs = in.f64();
-  r.maxTriangles = static_cast<std::size_t>(in.i64());
-  r.vertices = static_cast<std::size_t>(in.i64());
   r.notes.resize(in.count(8));
   for (auto& n : r.notes) n = in.str();
 }

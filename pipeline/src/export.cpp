@@ -15,6 +15,7 @@
 #include "crumple/exporters/png.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/inspect.hpp"
+#include "crumple/pipeline/output_lock.hpp"
 
 namespace crumple::pipeline {
 namespace {
@@ -114,6 +115,10 @@ ExportReport exportCache(const std::string& cachePath, const ExportOptions& opti
       reader.readFrame(0).pattern, cachePath + ": frame " + std::to_string(firstCached));
   const Vec3 colour = paperColour(header, cachePath, report.notes);
   prepareExportDir(report.outDir);
+  // A frame range shares the folder with the other ranges' exports (farm
+  // chunks), the whole cache has it alone.
+  const OutputLock lock(report.outDir,
+                        options.frames ? OutputLock::Mode::Shared : OutputLock::Mode::Exclusive);
   const fs::path dir(report.outDir);
   const bool wholeShot = range.first <= firstCached && range.last >= lastCached;
   const std::string shotStem =

@@ -382,7 +382,9 @@ int main(int argc, char** argv) {
   for (auto* cmd : {run, simulate}) {
     cmd->add_option("SCENE", a.scene, "scene.toml, or a folder holding one")->required();
     cmd->add_option("--out", a.out,
-                    "output folder (default: the scene's [output] dir, else out/<scene name>)");
+                    "output folder (default: the scene's [output] dir, else out/<scene name>); "
+                    "one crumple writes into a folder at a time (DIR/.crumple.lock): another "
+                    "one writing there makes this exit 2");
     cmd->add_option(
         "--frames", a.frames,
         "A-B: simulate from the scene's first frame to B, render A-B (default: the scene's range)");
@@ -397,8 +399,9 @@ int main(int argc, char** argv) {
                     "(atomically)")
         ->check(CLI::Range(1, 1 << 30));
     cmd->add_flag("--resume", a.resume,
-                  "go on from DIR/checkpoint.bin after an interruption: the cache ends "
-                  "byte-identical to an uninterrupted run's");
+                  "go on from DIR/checkpoint.bin after an interruption: the cache and the "
+                  "summary end as an uninterrupted run's (the cache byte-identical); exit 2 when "
+                  "the scene file, its animation file, paper preset or texture changed since");
   }
   addRenderOptions(run, a);
   run->add_flag(
@@ -412,7 +415,10 @@ int main(int argc, char** argv) {
   render->add_option("CACHE", a.cache, "a .pcache file")->required();
   render->add_option("--frames", a.frames, "A-B: frames to render (default: every cached frame)");
   addRenderOptions(render, a);
-  render->add_option("--out", a.out, "frames folder (default: frames/ beside the cache)");
+  render->add_option("--out", a.out,
+                     "frames folder (default: frames/ beside the cache); locked while rendering "
+                     "(exit 2 when another crumple writes there), shared by renders of a "
+                     "--frames range (a farm's array tasks)");
   render
       ->add_option("--threads", a.threads,
                    "embree: worker threads (the images are identical for any count); osmesa: "
@@ -426,7 +432,8 @@ int main(int argc, char** argv) {
   soundCmd->add_option("CACHE", a.cache, "a .pcache file")->required();
   soundCmd->add_option("--out", a.out,
                        "the WAV file, or a folder to write sound.wav into (default: sound.wav "
-                       "beside the cache)");
+                       "beside the cache); its folder is locked while writing (exit 2 when "
+                       "another crumple writes there)");
   soundCmd
       ->add_option("--rate", a.rate, "sample rate: 48000 or 44100 (default: the scene's, 48000)")
       ->check(CLI::IsMember({48000, 44100}));
@@ -484,7 +491,9 @@ int main(int argc, char** argv) {
   exportCmd->add_option("CACHE", a.cache, "a .pcache file")->required();
   exportCmd->add_option("--format", a.exportFormat, "obj, ply, gltf or usda")->required();
   exportCmd->add_option("--out", a.out,
-                        "output folder (default: export/<format>/ beside the cache)");
+                        "output folder (default: export/<format>/ beside the cache); locked while "
+                        "writing (exit 2 when another crumple writes there), shared by exports "
+                        "of a --frames range");
   exportCmd->add_option("--frames", a.frames,
                         "A-B: frames to export (default: every cached frame)");
   auto* farm = app.add_subcommand("farm", "Run a shot on a render farm (docs/FARM.md).");

@@ -16,7 +16,6 @@
 #include <numbers>
 #include <optional>
 #include <string_view>
-#include <tuple>
 
 #include "checkpoint.hpp"
 #include "cost_guard.hpp"
@@ -33,6 +32,7 @@
 #include "crumple/pipeline/contacts.hpp"
 #include "crumple/pipeline/handle_rig.hpp"
 #include "crumple/pipeline/inspect.hpp"
+#include "crumple/pipeline/output_lock.hpp"
 #include "crumple/pipeline/sound.hpp"
 #include "crumple/render/osmesa_renderer.hpp"
 #include "crumple/sim/colliders.hpp"
@@ -483,6 +483,9 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     animation = std::make_unique<io::AnimationScene>(io::AnimationScene::load(scene.animationFile));
     io::checkAnimationNodes(scene, *animation);
   }
+  // What a checkpoint records of the files read (docs/CHECKPOINT.md), hashed as they were read.
+  const std::vector<ShotInput> inputs =
+      options.checkpointEvery > 0 || options.resume ? shotInputs(scene) : std::vector<ShotInput>{};
   const double t0 = frameTime(scene, scene.frameStart);
   const bool hybridModel = scene.model.type == io::ModelSpec::Type::Hybrid;
   sim::SimParams params;
@@ -521,6 +524,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   // The look travels in the cache (texture, mesh props), read and checked now.
   const std::vector<cache::ExtensionBlock> lookBlocks = lookHeaderBlocks(scene, animation.get());
   prepareOutputDir(report.outDir, "output");
+  const OutputLock outputLock(report.outDir);  // one writer per folder, until the shot is done
   report.cachePath = (fs::path(report.outDir) / "cache.pcache").string();
   if (animation)
     for (const auto& w : animation->warnings())
@@ -532,9 +536,11 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     for (const auto& w : report.warnings) std::fprintf(options.log, "warning: %s\n", w.c_str());
   report.summaryPath = (fs::path(report.outDir) / "summary.json").string();
   std::unique_ptr<detail::FrameRenderer> renderer;
+  std::optional<OutputLock> framesLock;
   if (render) {
     report.framesDir = (fs::path(report.outDir) / "frames").string();
     prepareOutputDir(report.framesDir, "frames");
+    framesLock.emplace(report.framesDir);
     renderer = std::make_unique<detail::FrameRenderer>(
         scene, lookBlocks, report.framesDir, options.debugStructure, options.rendering, seed);
     report.renderBackend = backendName(options.rendering.backend);
@@ -601,7 +607,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   // how many cached frames go with it; the cache keeps those and goes on.
   const std::string checkpointPath = (fs::path(report.outDir) / kCheckpointFile).string();
   std::optional<Checkpoint> resumed;
-  if (options.resume) resumed = readCheckpoint(checkpointPath, scene, seed, range.last);
+  if (options.resume) resumed = readCheckpoint(checkpointPath, scene, inputs, seed, range.last);
   std::unique_ptr<cache::CacheWriter> writer =
       resumed ? cache::CacheWriter::resume(report.cachePath, header, resumed->cachedFrames)
               : std::make_unique<cache::CacheWriter>(report.cachePath, header);
@@ -629,30 +635,25 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   // The crumpling model's structure changes of the frame being emitted.
   std::optional<cache::ExtensionBlock> structureBlock;
   mesh::SheetMesh bakedSheet;  // the triangles and pattern tearAtlasBlock refers to
-  // Per handle pulled beyond the sheet's reach: first and last frame, most (m).
-  std::map<std::size_t, std::tuple<int, int, double>> beyondReach;
-  // Frames whose elastic step needed more Newton iterations, or went on
-  // without self-contact, after failing at every halving (first, last).
-  std::pair<int, int> newtonRetried{-1, -1}, selfContactDropped{-1, -1};
   const auto noteRecovery = [&](const sim::StepStats& stats, int frame) {
-    for (auto [happened, span] : {std::pair{stats.newtonRetried, &newtonRetried},
-                                  std::pair{stats.selfContactDropped, &selfContactDropped}})
+    for (auto [happened, span] : {std::pair{stats.newtonRetried, &report.newtonRetried},
+                                  std::pair{stats.selfContactDropped, &report.selfContactDropped}})
       if (happened > 0) {
         if (span->first < 0) span->first = frame;
-        span->second = frame;
+        span->last = frame;
       }
   };
   const auto stabilityWarnings = [&] {
-    if (newtonRetried.first >= 0)
-      report.warnings.push_back(
-          "the elastic solve needed " + std::to_string(sim::kRetryIterationFactor) +
-          " times [sim] max_newton_iterations at frames " + std::to_string(newtonRetried.first) +
-          "-" + std::to_string(newtonRetried.second));
-    if (selfContactDropped.first >= 0)
+    if (const auto& span = report.newtonRetried; span.first >= 0)
+      report.warnings.push_back("the elastic solve needed " +
+                                std::to_string(sim::kRetryIterationFactor) +
+                                " times [sim] max_newton_iterations at frames " +
+                                std::to_string(span.first) + "-" + std::to_string(span.last));
+    if (const auto& span = report.selfContactDropped; span.first >= 0)
       report.warnings.push_back(
           "the elastic solve failed with self-contact and went on without it at frames " +
-          std::to_string(selfContactDropped.first) + "-" +
-          std::to_string(selfContactDropped.second) + ": the sheet may pass through itself there");
+          std::to_string(span.first) + "-" + std::to_string(span.last) +
+          ": the sheet may pass through itself there");
     if (report.elasticHeldStill > 0)
       report.warnings.push_back(
           "the self-contact guard held the whole sheet still on " +
@@ -672,13 +673,12 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
                     report.elasticHeldStill > 0 ? " or passing through itself" : "");
       report.warnings.push_back(text);
     }
-    for (const auto& [h, span] : beyondReach) {
+    for (const auto& [h, span] : report.beyondReach) {
       char text[320];
       std::snprintf(text, sizeof text,
                     "handle '%s' is pulled beyond the sheet's reach at frames %d-%d (up to %.3g m "
                     "past it): it stops on the reach and lags behind its node there",
-                    rig.handles()[h].name.c_str(), std::get<0>(span), std::get<1>(span),
-                    std::get<2>(span));
+                    rig.handles()[h].name.c_str(), span.first, span.last, span.most);
       report.warnings.push_back(text);
     }
   };
@@ -733,10 +733,10 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
       record.handleTargets.push_back(rig.target(h, t));
       // A node beyond the sheet's reach (issue 9): the handle lags behind it.
       if (const double excess = rig.reachExcess(h, t); excess > 0.0) {
-        auto& [first, last, most] = beyondReach.try_emplace(h, -1, -1, 0.0).first->second;
-        if (first < 0) first = frame;
-        last = frame;
-        most = std::max(most, excess);
+        ShotReport::BeyondReach& span = report.beyondReach[h];
+        if (span.first < 0) span.first = frame;
+        span.last = frame;
+        span.most = std::max(span.most, excess);
       }
     }
     record.camera = cameraAt(scene, animation.get(), t);
@@ -1046,7 +1046,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   const auto checkpoint = [&](int frame) {
     const auto start = Clock::now();
     StateWriter w;
-    writeCheckpointHead(w, scene, seed, range.last, frame, writer->framesWritten());
+    writeCheckpointHead(w, scene, inputs, seed, range.last, frame, writer->framesWritten());
     saveReport(w, report);
     // The model: the crumpling model's layers, or the elastic model on its
     // (possibly torn) mesh.
@@ -1079,7 +1079,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
   int firstFrame = scene.frameStart + 1;
   if (resumed) {
     StateReader& in = *resumed->state;
-    restoreReport(in, report);
+    restoreReport(in, report, rig.handles().size());
     if (in.boolean()) {
       if (!hybrid) in.fail("holds the crumpling model's state, the scene runs the elastic model");
       hybrid->restoreState(in);
@@ -1246,6 +1246,7 @@ ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options) {
     SoundOptions soundOptions;
     soundOptions.log = options.log;
     soundOptions.interactive = options.interactive;
+    soundOptions.lockFolder = false;  // sound.wav goes beside the cache: outputLock's folder
     const SoundReport made = makeSound(report.cachePath, soundOptions);
     report.soundPath = made.wavPath;
     report.stages["sound"].totalMs += made.synthesisMs;
@@ -1305,6 +1306,8 @@ RenderReport renderCache(const std::string& cachePath, const RenderOptions& opti
   if ((options.rendering.contactSheet || options.rendering.movie) && !options.rendering.png)
     throw InputError("--contact-sheet/--movie", "need the PNG frames (drop --no-png)");
   prepareOutputDir(report.framesDir, "frames");
+  const OutputLock lock(report.framesDir,
+                        options.frames ? OutputLock::Mode::Shared : OutputLock::Mode::Exclusive);
   detail::FrameRenderer renderer(scene, header.extensions, report.framesDir, options.debugStructure,
                                  options.rendering, header.seed);
   Progress progress(std::string("crumple render (") + backendName(options.rendering.backend) + ")",

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include "crumple/core/error.hpp"
@@ -13,6 +14,7 @@
 #include "crumple/exporters/pcache.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/pipeline/inspect.hpp"
+#include "crumple/pipeline/output_lock.hpp"
 #include "crumple/sound/database.hpp"
 #include "crumple/sound/soundtrack.hpp"
 #include "crumple/sound/spectrogram.hpp"
@@ -151,6 +153,8 @@ SoundReport makeSound(const std::string& cachePath, const SoundOptions& options)
   report.wavPath = soundPath(cachePath, options.out);
   if (options.gainDb && !(std::abs(*options.gainDb) <= kMaxGainDb))
     throw InputError("--gain-db", "must be a number of dB within +-" + std::to_string(kMaxGainDb));
+  std::optional<OutputLock> lock;
+  if (options.lockFolder) lock.emplace(fs::path(report.wavPath).parent_path().string());
 
   const sound::SoundDatabase db =
       sound::SoundDatabase::load(report.databasePath).resampledTo(report.sampleRate);

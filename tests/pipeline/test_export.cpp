@@ -22,6 +22,7 @@
 #include "crumple/exporters/png.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/export.hpp"
+#include "crumple/pipeline/output_lock.hpp"
 #include "crumple/pipeline/shot.hpp"
 #include "sample_shot.hpp"
 #include "test_util.hpp"
@@ -127,11 +128,13 @@ std::map<std::string, std::vector<int>> usdaSamples(const std::string& text) {
   return samples;
 }
 
-// Every regular file below `dir`, relative path -> bytes.
+// Every regular file below `dir` but the folder's lock file (it stays,
+// holding no lock, after the export), relative path -> bytes.
 std::map<std::string, std::string> filesIn(const fs::path& dir) {
   std::map<std::string, std::string> out;
   for (const auto& e : fs::recursive_directory_iterator(dir))
-    if (e.is_regular_file()) out[fs::relative(e.path(), dir).string()] = readFile(e.path());
+    if (e.is_regular_file() && e.path().filename() != pipeline::kOutputLockFile)
+      out[fs::relative(e.path(), dir).string()] = readFile(e.path());
   return out;
 }
 

@@ -264,5 +264,32 @@ TEST(BadInputCases, SoundOptionsAndDamagedEvents) {
                     {bad.string(), "frame 2", "SEVT"});
 }
 
+// A killed writer's temporaries are removed by the next writer of the
+// folder; a write that fails (here the file size limit, as a full disk
+// does) leaves none and is exit 2 naming the file.
+TEST(Temporaries, NoneIsLeftBehind) {
+  TempDir tmp;
+  const fs::path cachePath = simulateSmall(tmp.path(), /*sound=*/true);
+  writeFile(tmp / "out/summary.json.tmp", "{ half written");
+  writeFile(tmp / "out/sound.wav.tmp", "RIFF");
+  writeFile(tmp / "out/0001.obj.4242.tmp", "v 0 0 0");
+  const auto again =
+      runCrumple("simulate " + (tmp / "scene").string() + " --out " + (tmp / "out").string());
+  EXPECT_EQ(again.status, 0) << again.output;
+  for (const char* name : {"summary.json.tmp", "sound.wav.tmp", "0001.obj.4242.tmp"})
+    EXPECT_FALSE(fs::exists(tmp / "out" / name)) << name;
+  EXPECT_TRUE(fs::exists(tmp / "out/summary.json"));
+  // 16 blocks of 512 bytes: the WAV (0.25 s of stereo 24-bit at 48 kHz,
+  // 72 kB) cannot be written; SIGXFSZ ignored, the write fails with EFBIG.
+  fs::create_directories(tmp / "full");
+  const auto full =
+      runCommand("ulimit -f 16; trap '' XFSZ; " + std::string(CRUMPLE_BIN) + " sound " +
+                 cachePath.string() + " --out " + (tmp / "full/sound.wav").string());
+  EXPECT_EQ(full.status, 2) << full.output;
+  EXPECT_NE(full.output.find((tmp / "full/sound.wav").string()), std::string::npos) << full.output;
+  for (const auto& e : fs::directory_iterator(tmp / "full"))
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+}
+
 }  // namespace
 }  // namespace crumple::testing

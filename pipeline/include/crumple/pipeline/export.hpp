@@ -44,8 +44,9 @@ struct ExportReport {
 //   usda: shot.usda
 // The shot files are named shot.glb / shot.usda when every cached frame is
 // exported, shot_A-B.glb / shot_A-B.usda for a range. Throws InputError for a
-// range outside the cached frames (naming them), an empty cache or an
-// unwritable folder, CorruptDataError for a damaged frame.
+// range outside the cached frames (naming them), an empty cache, an
+// unwritable folder or one another crumple is writing into (OutputLock: a
+// range shares it with other ranges), CorruptDataError for a damaged frame.
 ExportReport exportCache(const std::string& cachePath, const ExportOptions& options);
 
 }  // namespace crumple::pipeline

@@ -107,6 +107,19 @@ struct ShotReport {
     int maxFrame = -1;
   };
   std::vector<HandleLag> handleLags;
+  // Frames whose elastic step needed more Newton iterations, or went on
+  // without self-contact, after failing at every halving (first and last
+  // frame, -1: none), and each handle (by index) pulled beyond the sheet's
+  // reach (first and last frame, the most in metres): the warnings' record.
+  struct FrameSpan {
+    int first = -1, last = -1;
+  };
+  FrameSpan newtonRetried, selfContactDropped;
+  struct BeyondReach {
+    int first = -1, last = -1;
+    double most = 0.0;
+  };
+  std::map<std::size_t, BeyondReach> beyondReach;
   // Contacts (issue 5): collider and self-contact work (detection, the
   // failsafe; within the elastic stage, plus the crumpling model's failsafe
   // after its isometry), the deepest free vertex inside a collider or the
@@ -178,15 +191,19 @@ const char* tearKindName(tear::CandidateKind kind);
 mesh::SheetMesh buildSheet(const io::SceneSpec& scene, const io::AnimationScene* animation);
 
 // Simulates the shot and writes DIR/cache.pcache (and, with options.render,
-// DIR/frames/NNNN.png), then DIR/summary.json. Bad input throws InputError
-// before anything is written. A numerical failure closes the cache at the
-// last good frame, writes the summary with the error, and throws
-// NumericalError naming the frame and stage.
+// DIR/frames/NNNN.png), then DIR/summary.json, holding DIR's lock (and
+// DIR/frames') throughout (OutputLock). Bad input, or a folder another
+// crumple is writing into, throws InputError before anything is written. A
+// numerical failure closes the cache at the last good frame, writes the
+// summary with the error, and throws NumericalError naming the frame and
+// stage.
 ShotReport runShot(const io::SceneSpec& scene, const ShotOptions& options);
 
 // Renders frames of a cache with the chosen backend into framesDir
 // (NNNN.png and/or NNNN.exr, each written atomically), then the contact sheet
-// and the movie when asked. Returns the frames written.
+// and the movie when asked. Returns the frames written. Holds framesDir's
+// lock (OutputLock): exclusive for the whole cache, shared for a frame range
+// (a farm's array tasks render their chunks into one folder side by side).
 struct RenderOptions {
   std::optional<FrameRange> frames;  // default: all cached frames
   std::string framesDir;             // default: <cache folder>/frames

@@ -27,6 +27,9 @@ struct SoundOptions {
   bool spectrogram = true;           // the PNG beside the WAV (same name, .png)
   std::FILE* log = stderr;           // progress and notes; nullptr: quiet
   int interactive = -1;
+  // Hold the WAV's folder's lock (OutputLock) while writing; false for a
+  // caller that holds it already (`crumple run`).
+  bool lockFolder = true;
 };
 
 struct SoundReport {
@@ -58,7 +61,8 @@ cache::SoundEventRecord soundEventRecord(const sound::SoundEvent& event);
 std::string defaultSoundDatabase();
 
 // Throws InputError for a cache without events, a missing or malformed
-// database, a bad option; the WAV and PNG are written atomically.
+// database, a bad option, a WAV folder another crumple is writing into; the
+// WAV and PNG are written atomically.
 SoundReport makeSound(const std::string& cachePath, const SoundOptions& options);
 
 // `crumple sound --events`: one line per event (frame, time, kind,
