@@ -151,3 +151,14 @@ TEST(StateIo, RoundTripsAndRefusesDamage) {
   StateReader h(huge.data(), "t");
   EXPECT_THROW((void)h.f64s(), CorruptDataError);
 }
+
+// A checkpoint's points and vectors are finite: a NaN position is damage
+// (exit 2 on resume), not a state to simulate from.
+TEST(StateIo, ANonFinitePointIsDamage) {
+  StateWriter w;
+  w.vec3(Vec3(0.0, std::numeric_limits<double>::quiet_NaN(), 0.0));
+  w.vec2s({Vec2(1.0, 2.0), Vec2(std::numeric_limits<double>::infinity(), 0.0)});
+  StateReader r(w.data(), "t");
+  EXPECT_THROW((void)r.vec3(), CorruptDataError);
+  EXPECT_THROW((void)r.vec2s(), CorruptDataError);
+}

@@ -125,14 +125,19 @@ std::string StateReader::str() {
   return std::string(reinterpret_cast<const char*>(p), n);
 }
 
+// Points and vectors (positions, velocities, pattern points) are finite in
+// any state the simulation writes; a non-finite one is damage.
 Vec2 StateReader::vec2() {
   const double x = f64();
-  return {x, f64()};
+  const Vec2 v(x, f64());
+  if (!v.allFinite()) fail("a point or vector that is not finite");
+  return v;
 }
 
 Vec3 StateReader::vec3() {
   Vec3 v;
   for (int k = 0; k < 3; ++k) v[k] = f64();
+  if (!v.allFinite()) fail("a point or vector that is not finite");
   return v;
 }
 

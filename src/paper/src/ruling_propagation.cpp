@@ -407,7 +407,8 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
       for (std::size_t r = 0; r < regionCount; ++r) order.emplace_back(-worst[r], r);
       std::sort(order.begin(), order.end());
     }
-    for (const auto& [negWorst, r] : order) {
+    for (const auto& entry : order) {
+      const std::size_t r = entry.second;  // a plain local: lambdas below capture it
       if (declined[r] || g.regions[r].type != mesh::RegionType::Flat) continue;
       // (a) the most compressed triangle and its direction of minimal compression.
       int tcomp = -1;

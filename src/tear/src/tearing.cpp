@@ -242,8 +242,9 @@ bool Tearing::cutTo(mesh::SheetMesh& mesh, int vertex, const Vec2& to, TearEvent
       result.blends[static_cast<std::size_t>(v) - result.vertexCountBefore] = b;
       continue;
     }
+    const int vertex = v;  // a plain local for the lambda (clang 14 cannot capture a binding)
     const auto it = std::find_if(result.relocated.begin(), result.relocated.end(),
-                                 [&](const auto& m) { return m.first == v; });
+                                 [&](const auto& m) { return m.first == vertex; });
     if (it != result.relocated.end()) {
       it->second = b;
     } else {
