@@ -27,10 +27,21 @@ std::string indexProblem(const Range& indices, std::size_t n, int lowest, const 
   return {};
 }
 
+// Farther than any scene reaches; a bound on every coordinate keeps the
+// tools' lengths, squares and bounding boxes finite (a CRC-valid frame with
+// a vertex at 1e300 m crashed the self-penetration measure's AABB tree).
+constexpr double kMaxCoordinate = 1e9;  // m
+
+template <typename Vec>
+bool inBounds(const Vec& p) {
+  return p.allFinite() && p.cwiseAbs().maxCoeff() <= kMaxCoordinate;
+}
+
 template <typename Vec>
 std::string firstNonFinite(const std::vector<Vec>& points, const char* what) {
   for (std::size_t i = 0; i < points.size(); ++i)
-    if (!points[i].allFinite()) return std::string(what) + " " + num(i) + " is not finite";
+    if (!inBounds(points[i]))
+      return std::string(what) + " " + num(i) + " is not finite or beyond 1e9 m";
   return {};
 }
 
@@ -131,7 +142,7 @@ std::string validate(const FrameRecord& f, const CacheHeader& h) {
   if (auto p = structureProblem(f); !p.empty()) return p;
   if (auto p = handleProblem(f, h); !p.empty()) return p;
   const CameraRecord& c = f.camera;
-  if (!c.position.allFinite() || !c.rotation.coeffs().allFinite() || !(c.rotation.norm() > 0.0) ||
+  if (!inBounds(c.position) || !c.rotation.coeffs().allFinite() || !(c.rotation.norm() > 0.0) ||
       !std::isfinite(c.yfov) || c.yfov < 0.0 || c.yfov >= std::numbers::pi)
     return "camera: not a finite pose with a field of view in [0, pi)";
   try {

@@ -96,7 +96,7 @@ TEST(HostileCache, AnImpossibleFpsOrANonFinitePositionIsExit2) {
     if (f.frame == 3) f.positions[2].y() = std::numeric_limits<double>::quiet_NaN();
   });
   expectExit2Naming(runCrumple("render " + nan.string() + " --out " + (tmp / "frames").string()),
-                    {nan.string(), "frame 3", "positions: vertex 2 is not finite"});
+                    {nan.string(), "frame 3", "positions: vertex 2 is not finite or beyond 1e9 m"});
 }
 
 // A cache without its footer (the shot was killed after frame 3 of 6) still
