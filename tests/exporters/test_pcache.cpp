@@ -116,7 +116,8 @@ FrameRecord makeFrame(int k) {
   }
   for (std::size_t v = 0; v < f.pattern.size(); ++v)
     f.positions.push_back(Vec3(f.pattern[v].x(), f.pattern[v].y(), 0.1 * k + 1e-17 * v));
-  f.positions[0] = Vec3(-0.0, std::numeric_limits<double>::denorm_min(), 1e308);
+  // The reader's bound on coordinates (1e9 m) is inclusive.
+  f.positions[0] = Vec3(-0.0, std::numeric_limits<double>::denorm_min(), 1e9);
   f.positions[1].z() = std::numbers::pi * k;
   if (k % 2 == 1) {
     f.singularVertices = {1, 3};

@@ -168,8 +168,10 @@ TEST(CostGuardShot, AFrameOverItsBudgetStopsTheShotNamingTheLikelyCause) {
   TempDir tmp;
   const fs::path scene =
       smallShot(tmp / "s",
+                // Bound at frame 1 (t = 1/24 s), a kilometre away from frame 2 on:
+                // whichever frame runs past the budget, the cause is there.
                 {{"A",
-                  {0.0f, 0.1f, 0.15f},
+                  {0.0f, 0.042f, 0.05f},
                   {{-0.05f, 0.2f, 0.0f}, {-0.05f, 0.2f, 0.0f}, {1000.0f, 0.2f, 0.0f}}},
                  {"B", {0.0f, 0.25f}, {{0.05f, 0.2f, 0.0f}, {0.05f, 0.2f, 0.0f}}}},
                 "frame_budget_s = 0.001\n");
