@@ -9,7 +9,8 @@
 #   export     the middle frame as obj, ply, gltf and usda
 #   inspect    --json of the cache
 # and every file written is hashed (SHA-256) into a manifest; summary.json
-# (wall-clock timings) and the lock file are left out.
+# and checkpoint.bin (both hold wall-clock timings) and the lock file are
+# left out (test_resume checks that a resumed run's cache is byte-identical).
 #
 # Usage:
 #   scripts/identical-outputs.sh record BUILD_DIR|BINARY MANIFEST [SCENE_NAME...]
@@ -21,8 +22,10 @@
 #       working tree in build/, record both manifests and diff them; exit 0
 #       when every output is byte-identical, 1 with the differing files listed
 # SCENE_NAME is a sample folder's name (crumple, drape, ...) or
-# paper-types/eps-0.5; default: all of them. Takes about 25 minutes for all
-# scenes on 2 cores (per binary).
+# paper-types/eps-0.5; default: all of them. A run that fails is a line
+# "FAILED scene: its last message" in the manifest (and compared too). Takes
+# about an hour for all scenes on 2 cores (per binary). The scenes are copied
+# to $CRUMPLE_IDENTICAL_STAGE (default /tmp/crumple-identical-scenes).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
@@ -35,14 +38,25 @@ all_scenes() {
   done
 }
 
-scene_path() {
-  case "$1" in
-  paper-types/*) echo "$root/samples/$1.toml" ;;
-  *) echo "$root/samples/$1" ;;
-  esac
+# A copy of each scene at a fixed path (its path is in the cache's header,
+# so both binaries must read it from the same place) with the cost guard off
+# ([scene] frame_budget_s = 0): the guard stops a run by wall-clock time, which
+# a loaded machine changes; it never changes what a finished run writes.
+stage_scenes() {
+  local stage="$1"
+  shift
+  rm -rf "$stage"
+  mkdir -p "$stage"
+  for s in "$@"; do
+    local folder="${s%%/*}"
+    [ -d "$stage/$folder" ] || cp -r "$root/samples/$folder" "$stage/$folder"
+  done
+  find "$stage" -name '*.toml' -print0 | while IFS= read -r -d '' f; do
+    grep -q 'frame_budget_s' "$f" || sed -i '/^\[scene\]/a frame_budget_s = 0' "$f"
+  done
 }
 
-# record BUILD_DIR MANIFEST [SCENE...]
+# record BUILD_DIR|BINARY MANIFEST [SCENE...]
 record() {
   local build="$1" manifest="$2"
   shift 2
@@ -51,38 +65,45 @@ record() {
   [ -x "$bin" ] || { echo "no crumple binary at $build" >&2; exit 2; }
   local scenes=("$@")
   [ ${#scenes[@]} -gt 0 ] || mapfile -t scenes < <(all_scenes)
+  local stage="${CRUMPLE_IDENTICAL_STAGE:-/tmp/crumple-identical-scenes}"
+  stage_scenes "$stage" "${scenes[@]}"
   local work
   work="$(mktemp -d)"
-  # shellcheck disable=SC2064
-  trap "rm -rf '$work'" RETURN
+  : >"$manifest"
   for s in "${scenes[@]}"; do
-    local out="$work/${s//\//_}"
-    local scene
-    scene="$(scene_path "$s")"
+    local name="${s//\//_}"
+    local out="$work/$name"
+    local scene="$stage/$s"
+    [ -d "$scene" ] || scene="$scene.toml"
     echo "== $s" >&2
-    "$bin" run "$scene" --out "$out" --threads 2 --checkpoint-every 20 >"$out.log" 2>&1 ||
-      { echo "run failed for $s:" >&2; tail -5 "$out.log" >&2; exit 1; }
-    local frames first last mid
-    frames="$("$bin" inspect --json "$out/cache.pcache" | python3 -c \
-      'import json,sys; f=json.load(sys.stdin)["frames"]; print(f[0]["frame"], f[-1]["frame"])')"
-    first="${frames% *}"
-    last="${frames#* }"
-    mid=$(((first + last) / 2))
-    for f in "$first" "$mid" "$last"; do
-      "$bin" render "$out/cache.pcache" --backend embree --spp 4 --threads 2 \
-        --frames "$f-$f" --exr --out "$out/embree" >>"$out.log" 2>&1
-    done
-    "$bin" render "$out/cache.pcache" --debug-structure --frames "$mid-$mid" \
-      --out "$out/structure" >>"$out.log" 2>&1
-    for fmt in obj ply gltf usda; do
-      "$bin" export "$out/cache.pcache" --format "$fmt" --frames "$mid-$mid" \
-        --out "$out/export-$fmt" >>"$out.log" 2>&1
-    done
-    "$bin" inspect --json "$out/cache.pcache" >"$out/inspect.json"
+    if ! "$bin" run "$scene" --out "$out" --threads 2 --checkpoint-every 20 >"$out.log" 2>&1; then
+      echo "FAILED $name: $(tail -1 "$out.log")" >>"$manifest"
+      echo "run failed for $s: $(tail -1 "$out.log")" >&2
+    else
+      local frames first last mid
+      frames="$("$bin" inspect --json "$out/cache.pcache" | python3 -c \
+        'import json,sys; f=json.load(sys.stdin)["frames"]; print(f[0]["frame"], f[-1]["frame"])')"
+      first="${frames% *}"
+      last="${frames#* }"
+      mid=$(((first + last) / 2))
+      for f in "$first" "$mid" "$last"; do
+        "$bin" render "$out/cache.pcache" --backend embree --spp 4 --threads 2 \
+          --frames "$f-$f" --exr --out "$out/embree" >>"$out.log" 2>&1
+      done
+      "$bin" render "$out/cache.pcache" --debug-structure --frames "$mid-$mid" \
+        --out "$out/structure" >>"$out.log" 2>&1
+      for fmt in obj ply gltf usda; do
+        "$bin" export "$out/cache.pcache" --format "$fmt" --frames "$mid-$mid" \
+          --out "$out/export-$fmt" >>"$out.log" 2>&1
+      done
+      "$bin" inspect --json "$out/cache.pcache" >"$out/inspect.json"
+    fi
+    (cd "$work" && find "./$name" -type f ! -name summary.json ! -name checkpoint.bin \
+      ! -name .crumple.lock -print0 | sort -z | xargs -0 -r sha256sum) >>"$manifest"
+    rm -rf "$out" "$out.log"
   done
-  (cd "$work" && find . -type f ! -name summary.json ! -name .crumple.lock ! -name '*.log' -print0 |
-    sort -z | xargs -0 sha256sum) >"$manifest"
-  echo "$(wc -l <"$manifest") files hashed into $manifest" >&2
+  rm -rf "$work"
+  echo "$(grep -vc '^FAILED' "$manifest") files hashed into $manifest" >&2
 }
 
 compare() {
@@ -120,17 +141,17 @@ compare() {
 
 case "${1:-}" in
 record)
-  [ $# -ge 3 ] || { sed -n '14,26p' "$0" >&2; exit 2; }
+  [ $# -ge 3 ] || { sed -n '15,28p' "$0" >&2; exit 2; }
   shift
   record "$@"
   ;;
 compare)
-  [ $# -ge 2 ] || { sed -n '14,26p' "$0" >&2; exit 2; }
+  [ $# -ge 2 ] || { sed -n '15,28p' "$0" >&2; exit 2; }
   shift
   compare "$@"
   ;;
 *)
-  sed -n '2,26p' "$0" >&2
+  sed -n '2,28p' "$0" >&2
   exit 2
   ;;
 esac

@@ -11,6 +11,6 @@ BUILD_DIR=${BUILD_DIR:-build}
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$BUILD_DIR" --target make_sound_db
 mkdir -p assets/sound/default
-"$BUILD_DIR/src/sound/make_sound_db" --force assets/sound/default
+"$BUILD_DIR/make_sound_db" --force assets/sound/default
 du -sh assets/sound/default >&2
 git status --short assets/sound/default | head -5

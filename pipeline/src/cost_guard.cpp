@@ -56,6 +56,11 @@ void CostGuard::frameDone(int frame, double seconds, long halvings, const std::s
   throw NumericalError("cost guard", frame, problem);
 }
 
+void CostGuard::newRegime() {
+  seconds_.clear();
+  slow_ = 0;
+}
+
 NumericalError CostGuard::budgetError(int frame, const std::string& stage,
                                       const std::string& cause) const {
   const double b = budget();
@@ -106,14 +111,14 @@ std::string likelyCostCause(const std::vector<std::string>& names,
   return {};
 }
 
-std::string likelyCostCause(const HandleRig& rig, const std::vector<Vec2>& pattern, double t,
+std::string likelyCostCause(const model::HandleRig& rig, const std::vector<Vec2>& pattern, double t,
                             double tPrevious) {
   std::vector<std::string> names;
   std::vector<Vec2> points;
   std::vector<Vec3> now, before;
   std::vector<char> held;
   for (std::size_t h = 0; h < rig.handles().size(); ++h) {
-    const BoundHandle& b = rig.handles()[h];
+    const model::BoundHandle& b = rig.handles()[h];
     const bool bound = b.vertex >= 0 && static_cast<std::size_t>(b.vertex) < pattern.size();
     names.push_back(b.name);
     points.push_back(bound ? pattern[static_cast<std::size_t>(b.vertex)] : Vec2::Zero());

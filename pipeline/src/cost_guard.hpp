@@ -11,7 +11,7 @@
 
 #include "crumple/core/error.hpp"
 #include "crumple/core/types.hpp"
-#include "crumple/pipeline/handle_rig.hpp"
+#include "crumple/model/handle_rig.hpp"
 
 namespace crumple::pipeline {
 
@@ -45,6 +45,10 @@ class CostGuard {
   // (stage "cost guard") on a crawl or on the halvings rule; `cause` is
   // appended.
   void frameDone(int frame, double seconds, long halvings, const std::string& cause);
+  // The shot's cost changed regime (a torn crumpling-model sheet handed over
+  // to the elastic model on a finer mesh): the frames from now on are judged
+  // against their own median, after a new warm-up.
+  void newRegime();
   // A NumericalError for a frame whose budget ran out in `stage`.
   NumericalError budgetError(int frame, const std::string& stage, const std::string& cause) const;
 
@@ -69,7 +73,7 @@ std::string likelyCostCause(const std::vector<std::string>& names,
 
 // The same for the rig's handles between times tPrevious and t, their pattern
 // points read from `pattern` (the frame's, by handle vertex).
-std::string likelyCostCause(const HandleRig& rig, const std::vector<Vec2>& pattern, double t,
+std::string likelyCostCause(const model::HandleRig& rig, const std::vector<Vec2>& pattern, double t,
                             double tPrevious);
 
 }  // namespace crumple::pipeline

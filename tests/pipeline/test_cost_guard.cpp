@@ -57,6 +57,21 @@ TEST(CostGuard, ItStopsAfterFramesInARowThatStayDear) {
   for (int f = 0; f < 10; ++f) off.frameDone(f, 1.0, 1000, "");
 }
 
+// A hand-over to a dearer model starts a new regime: its frames are not
+// judged against the cheap frames before it.
+TEST(CostGuard, ANewRegimeIsJudgedAgainstItsOwnFrames) {
+  CostGuard guard(std::nullopt);
+  for (int f = 0; f < 10; ++f) guard.frameDone(f, 0.2, 0, "");
+  guard.newRegime();
+  EXPECT_EQ(guard.budget(), CostGuard::kFirstFramesBudget);
+  for (int f = 10; f < 20; ++f) guard.frameDone(f, 12.0, 0, "");  // 60x the old median
+  EXPECT_DOUBLE_EQ(guard.budget(), CostGuard::kRunawayFactor * 12.0);
+  CostGuard same(std::nullopt);
+  for (int f = 0; f < 10; ++f) same.frameDone(f, 0.2, 0, "");
+  EXPECT_THROW(
+      for (int f = 10; f < 20; ++f) same.frameDone(f, 12.0, 0, ""), NumericalError);
+}
+
 TEST(CostGuard, ItStopsAfterFramesInARowThatKeepHalving) {
   CostGuard guard(std::nullopt);
   const long many = CostGuard::kHalvingsPerFrame + 1;

@@ -1,7 +1,7 @@
 // Scene-level tests of the hybrid crumpling model on the samples that
 // reproduce the seeds' experiments (issue 3 acceptance). Each asserts the
 // property over every simulated frame, with the region invariants checked
-// after every geometric step (CRUMPLE_CHECK_INVARIANTS=1).
+// after every geometric step (--debug invariants).
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -14,6 +14,7 @@
 #include <numbers>
 #include <numeric>
 
+#include "crumple/core/debug.hpp"
 #include "crumple/core/error.hpp"
 #include "crumple/exporters/pcache.hpp"
 #include "crumple/exporters/png.hpp"
@@ -41,7 +42,9 @@ struct Shot {
 Shot simulate(const std::string& sample, int last, std::optional<std::uint64_t> seed,
               const TempDir& dir, const std::function<void(io::SceneSpec&)>& tweak = {},
               const std::string& outName = {}) {
-  ::setenv("CRUMPLE_CHECK_INVARIANTS", "1", 1);
+  DebugOptions debug;
+  debug.invariants = true;
+  setDebugOptions(debug);
   io::SceneSpec scene = io::loadScene(io::resolveScenePath(sourcePath("samples/" + sample)));
   if (tweak) tweak(scene);
   const std::string out = outName.empty() ? sample : sample + "-" + outName;

@@ -12,7 +12,8 @@
 #include "crumple/exporters/pcache_contacts.hpp"
 #include "crumple/io/animation.hpp"
 #include "crumple/io/scene.hpp"
-#include "crumple/pipeline/handle_rig.hpp"
+#include "crumple/model/handle_rig.hpp"
+#include "crumple/model/sheet_setup.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/shot.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
@@ -117,7 +118,7 @@ TEST(Shot, HandlesTrackTheirCurvesForEveryFormat) {
     EXPECT_LT(deviation, 1e-6) << file;
     const cache::CacheReader reader(report.cachePath);
     // The tangent-plane vertices (3 on a border) follow the node's rotation.
-    const auto held = pipeline::tangentNeighbours(pipeline::buildSheet(spec, &anim),
+    const auto held = model::tangentNeighbours(model::buildSheet(spec, &anim),
                                                   reader.readFrame(0).handleVertices[0], 0);
     EXPECT_EQ(held.size(), 3u);
     std::vector<Vec3> traj;
@@ -191,12 +192,12 @@ TEST(HandleRig, TangentControlPicksTwoThreeOrFourNeighbours) {
   const int corner = mesh::nearestPatternVertex(sheet, Vec2(0, 0));
   const int border = mesh::nearestPatternVertex(sheet, Vec2(0.1, 0));
   const int inside = mesh::nearestPatternVertex(sheet, Vec2(0.1, 0.1));
-  EXPECT_EQ(pipeline::tangentNeighbours(sheet, corner, 0).size(), 2u);
-  EXPECT_EQ(pipeline::tangentNeighbours(sheet, border, 0).size(), 3u);
-  EXPECT_EQ(pipeline::tangentNeighbours(sheet, inside, 0).size(), 4u);
-  EXPECT_EQ(pipeline::tangentNeighbours(sheet, inside, 2).size(), 2u);
+  EXPECT_EQ(model::tangentNeighbours(sheet, corner, 0).size(), 2u);
+  EXPECT_EQ(model::tangentNeighbours(sheet, border, 0).size(), 3u);
+  EXPECT_EQ(model::tangentNeighbours(sheet, inside, 0).size(), 4u);
+  EXPECT_EQ(model::tangentNeighbours(sheet, inside, 2).size(), 2u);
   // The four around an interior vertex span all directions.
-  const auto four = pipeline::tangentNeighbours(sheet, inside, 4);
+  const auto four = model::tangentNeighbours(sheet, inside, 4);
   Vec2 sum = Vec2::Zero();
   for (int n : four) sum += (sheet.pattern[n] - sheet.pattern[inside]).normalized();
   EXPECT_LT(sum.norm(), 0.5);
@@ -222,8 +223,8 @@ TEST(HandleRig, TangentVerticesFollowTheNodeRotation) {
   writeFile(tmp / "s/scene.toml", scene);
   const auto spec = io::loadScene((tmp / "s/scene.toml").string());
   const auto anim = io::AnimationScene::load(spec.animationFile);
-  auto sheet = pipeline::buildSheet(spec, &anim);
-  const pipeline::HandleRig rig(spec, &anim, sheet, 0.0);
+  auto sheet = model::buildSheet(spec, &anim);
+  const model::HandleRig rig(spec, &anim, sheet, 0.0);
   ASSERT_EQ(rig.handles().size(), 1u);
   EXPECT_EQ(rig.handles()[0].tangentVertices.size(), 2u) << "a corner holds two neighbours";
   rig.snap(0.0, sheet.positions);
@@ -317,7 +318,7 @@ TEST(Shot, PatternMeshFromTheAnimationFileBecomesTheSheet) {
   writeFile(tmp / "s/scene.toml", scene);
   const auto spec = io::loadScene((tmp / "s/scene.toml").string());
   const auto anim = io::AnimationScene::load(spec.animationFile);
-  const auto sheet = pipeline::buildSheet(spec, &anim);
+  const auto sheet = model::buildSheet(spec, &anim);
   EXPECT_EQ(mesh::validate(sheet), "");
   ASSERT_EQ(sheet.vertexCount(), 4u);
   double area = 0.0;
@@ -400,8 +401,8 @@ TEST(HandleRig, SaysHowFarAHandleIsFromItsVertex) {
   writeFile(tmp / "s/scene.toml", scene);
   const auto spec = io::loadScene((tmp / "s/scene.toml").string());
   const auto anim = io::AnimationScene::load(spec.animationFile);
-  const auto sheet = pipeline::buildSheet(spec, &anim);
-  const pipeline::HandleRig rig(spec, &anim, sheet, spec.frameTime(spec.frameStart));
+  const auto sheet = model::buildSheet(spec, &anim);
+  const model::HandleRig rig(spec, &anim, sheet, spec.frameTime(spec.frameStart));
   auto count = [](const std::vector<std::string>& warnings, const std::string& what) {
     return std::count_if(warnings.begin(), warnings.end(),
                          [&](const std::string& w) { return w.find(what) != std::string::npos; });
@@ -419,7 +420,7 @@ TEST(HandleRig, SaysHowFarAHandleIsFromItsVertex) {
   writeSmallScene(tmp / "ok");
   const auto good = io::loadScene((tmp / "ok/scene.toml").string());
   const auto goodAnim = io::AnimationScene::load(good.animationFile);
-  const pipeline::HandleRig exact(good, &goodAnim, pipeline::buildSheet(good, &goodAnim),
+  const model::HandleRig exact(good, &goodAnim, model::buildSheet(good, &goodAnim),
                                   good.frameTime(good.frameStart));
   EXPECT_EQ(count(exact.bindWarnings(), "pattern point"), 0);
 }

@@ -10,7 +10,8 @@
 #include "crumple/io/animation.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
-#include "crumple/pipeline/handle_rig.hpp"
+#include "crumple/model/handle_rig.hpp"
+#include "crumple/model/sheet_setup.hpp"
 #include "crumple/pipeline/shot.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
 
@@ -105,12 +106,12 @@ TEST(HandleReach, TheMovingHandleStopsOnTheSheetsReachUnlessItMayTear) {
   io::SceneSpec scene =
       io::loadScene(io::resolveScenePath(sourcePath("tests/stability/scenes/beyond-reach")));
   const io::AnimationScene anim = io::AnimationScene::load(scene.animationFile);
-  const mesh::SheetMesh sheet = pipeline::buildSheet(scene, &anim);
+  const mesh::SheetMesh sheet = model::buildSheet(scene, &anim);
   const double t0 = scene.frameStart / scene.fps;
   const double t = 1.25;
-  const double reach = 0.10 * (1.0 + pipeline::HandleRig::kReachSlack);
+  const double reach = 0.10 * (1.0 + model::HandleRig::kReachSlack);
   {
-    const pipeline::HandleRig rig(scene, &anim, sheet, t0);
+    const model::HandleRig rig(scene, &anim, sheet, t0);
     std::vector<sim::Pin> pins;
     rig.pins(t, pins);
     ASSERT_EQ(pins.size(), 2u);
@@ -125,7 +126,7 @@ TEST(HandleReach, TheMovingHandleStopsOnTheSheetsReachUnlessItMayTear) {
     EXPECT_EQ(rig.reachExcess(1, t0), 0.0);
   }
   scene.tear.enabled = true;
-  const pipeline::HandleRig tearing(scene, &anim, sheet, t0);
+  const model::HandleRig tearing(scene, &anim, sheet, t0);
   std::vector<sim::Pin> pins;
   tearing.pins(t, pins);
   EXPECT_EQ(pins[1].position, tearing.target(1, t));

@@ -3,17 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
+#include <string>
+
+#include "crumple/core/debug.hpp"
 
 namespace crumple::paper::detail {
 
-int stepTraceLevel() {
-  static const int level = [] {
-    const char* env = std::getenv("CRUMPLE_DEBUG_GEOMETRY");
-    return env != nullptr && env[0] >= '1' && env[0] <= '3' ? env[0] - '0' : 0;
-  }();
-  return level;
-}
+int stepTraceLevel() { return debugOptions().geometry; }
 
 double maxHingeAngle(const sim::ElasticSheet& elastic) {
   double out = 0.0;
@@ -137,9 +133,9 @@ void printStepTrace(int level, int frame, const GeometricMesh& sg, const Physica
 }
 
 void dumpFailedStep(const mesh::SheetMesh& mm, std::size_t geometricCount) {
-  const char* dump = std::getenv("CRUMPLE_DEBUG_DUMP");
-  if (dump == nullptr) return;
-  std::FILE* f = std::fopen(dump, "w");
+  const std::string& dump = debugOptions().dump;
+  if (dump.empty()) return;
+  std::FILE* f = std::fopen(dump.c_str(), "w");
   if (f == nullptr) return;
   std::vector<int> uses(mm.vertexCount(), 0);
   for (const auto& t : mm.triangles)

@@ -2,6 +2,7 @@
 // with a backtracking line search, substep halving and the recovery of a
 // step that failed at every halving (the method: elastic_sheet.cpp's header
 // comment; paper Sec. 4, thesis 2.3.1).
+#include "crumple/core/debug.hpp"
 #include "crumple/core/work_budget.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
 #include "elastic_sheet_impl.hpp"
@@ -392,10 +393,7 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
   s.h = t1 - t0;
   startNewton(s);
   findContacts(x, s.xk, s.h, stats);
-  static const bool debugNewton = [] {
-    const char* e = std::getenv("CRUMPLE_DEBUG_NEWTON");
-    return e != nullptr && e[0] == '1';
-  }();
+  const bool debugNewton = debugOptions().newton;
   const double tol = params.newtonTolerance * typicalEdge;
   // Nothing to solve when every vertex is pinned: the step is the pins.
   bool converged = freeCount == 0;

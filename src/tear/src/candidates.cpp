@@ -116,4 +116,18 @@ std::vector<TearCandidate> tearCandidates(const mesh::SheetMesh& mesh, const std
   return out;
 }
 
+const char* candidateKindName(CandidateKind kind) {
+  switch (kind) {
+    case CandidateKind::Tip:
+      return "tip";
+    case CandidateKind::Junction:
+      return "junction";
+    case CandidateKind::HandleBorder:
+      return "handle_border";
+    case CandidateKind::InwardCorner:
+      return "inward_corner";
+  }
+  return "?";
+}
+
 }  // namespace crumple::tear

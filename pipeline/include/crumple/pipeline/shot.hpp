@@ -184,12 +184,6 @@ struct ShotReport {
   std::string error;  // set when the run stopped early (cache valid up to the last frame)
 };
 
-// "tip", "junction", "handle_border" or "inward_corner" (summary.json).
-const char* tearKindName(tear::CandidateKind kind);
-
-// The simulation mesh of the scene's sheet, placed in the world.
-mesh::SheetMesh buildSheet(const io::SceneSpec& scene, const io::AnimationScene* animation);
-
 // Simulates the shot and writes DIR/cache.pcache (and, with options.render,
 // DIR/frames/NNNN.png), then DIR/summary.json, holding DIR's lock (and
 // DIR/frames') throughout (OutputLock). Bad input, or a folder another

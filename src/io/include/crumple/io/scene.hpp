@@ -58,7 +58,7 @@ struct HandleSpec {
   int tangentVertices = 0;
   // A finger's contact patch instead of tangent-plane vertices (m; 0 =
   // the vertices): the node holds the points of the sheet at this radius
-  // around the handle, softly (pipeline::HandleRig, sim::Grip).
+  // around the handle, softly (model::HandleRig, sim::Grip).
   double patchRadius = 0.0;
   std::optional<double> releaseTime;  // s: the handle lets go at this time
 };

@@ -12,6 +12,8 @@
 namespace crumple::tear {
 
 enum class CandidateKind : std::uint8_t { Tip, Junction, HandleBorder, InwardCorner };
+// "tip", "junction", "handle_border" or "inward_corner" (summary.json, traces).
+const char* candidateKindName(CandidateKind kind);
 
 struct TearCandidate {
   int vertex = -1;

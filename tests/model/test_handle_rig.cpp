@@ -9,9 +9,9 @@
 #include "crumple/io/animation.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
-#include "crumple/pipeline/handle_rig.hpp"
+#include "crumple/model/handle_rig.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
-#include "test_util.hpp"
+#include "../pipeline/test_util.hpp"
 
 using namespace crumple;
 using namespace crumple::testing;
@@ -76,7 +76,7 @@ TEST(HandleRig, RebindKeepsThePatternDistancesOfAStretchedNeighbourhood) {
   // 1.1x around the handle and tilted: offsets copied from the current
   // positions would be 1.1x the pattern.
   f.place(f.anim.worldPose("A", 0.0).position, 0.8 * Mat3::Identity());
-  pipeline::HandleRig rig(f.spec, &f.anim, f.sheet, 0.0);
+  model::HandleRig rig(f.spec, &f.anim, f.sheet, 0.0);
   ASSERT_EQ(rig.handles().size(), 1u);
   const double t = 0.5;
   const Vec3 node = rig.target(0, t);
@@ -109,7 +109,7 @@ TEST(HandleRig, RebindTurnsThePatternOntoTheCurrentTangentPlane) {
   // Bind on the flat pattern, then turn the sheet 30 degrees about an axis
   // through the handle: the rebound pins follow the turned plane.
   f.place(f.anim.worldPose("A", 0.0).position, Mat3::Identity());
-  pipeline::HandleRig rig(f.spec, &f.anim, f.sheet, 0.0);
+  model::HandleRig rig(f.spec, &f.anim, f.sheet, 0.0);
   ASSERT_EQ(rig.handles().size(), 1u);
   const double t = 0.5;
   const Vec3 node = rig.target(0, t);
@@ -147,8 +147,8 @@ TEST(HandleRig, AVertexInNoTriangleHasNoTangentNeighbours) {
   sheet.positions = {{0.0, 0.0, 0.0}, {0.01, 0.0, 0.0}, {0.0, 0.01, 0.0}, {0.05, 0.05, 0.0}};
   sheet.triangles = {{0, 1, 2}};
   sheet.regionOfTriangle = {0};
-  EXPECT_TRUE(pipeline::tangentNeighbours(sheet, 3, 0).empty());
-  EXPECT_EQ(pipeline::tangentNeighbours(sheet, 0, 0).size(), 2u) << "a corner: 2";
+  EXPECT_TRUE(model::tangentNeighbours(sheet, 3, 0).empty());
+  EXPECT_EQ(model::tangentNeighbours(sheet, 0, 0).size(), 2u) << "a corner: 2";
 }
 
 // A finger that holds a patch ([[handles]] patch_radius) pins only its
@@ -160,7 +160,7 @@ TEST(HandleRig, APatchPinsTheHandleAndGripsSixPointsThatTurnWithTheNode) {
   RigFixture f;
   f.spec.handles[0].patchRadius = 0.005;
   f.place(f.anim.worldPose("A", 0.0).position, Mat3::Identity());
-  pipeline::HandleRig rig(f.spec, &f.anim, f.sheet, 0.0);
+  model::HandleRig rig(f.spec, &f.anim, f.sheet, 0.0);
   std::vector<sim::Pin> pins;
   rig.pins(0.0, pins);
   ASSERT_EQ(pins.size(), 1u) << "the patch replaces the tangent-plane vertices";
@@ -198,13 +198,13 @@ TEST(HandleRig, APatchPinsTheHandleAndGripsSixPointsThatTurnWithTheNode) {
   corner.spec.handles[0].patternPoint = Vec2(0.0, 0.0);
   corner.spec.handles[0].patchRadius = 0.005;
   corner.place(corner.anim.worldPose("A", 0.0).position, Mat3::Identity());
-  pipeline::HandleRig cornerRig(corner.spec, &corner.anim, corner.sheet, 0.0);
+  model::HandleRig cornerRig(corner.spec, &corner.anim, corner.sheet, 0.0);
   cornerRig.grips(0.0, kStiffness, grips);
   EXPECT_EQ(grips.size(), 2u);
   // Without a patch radius there are no grips.
   RigFixture pinned;
   pinned.place(pinned.anim.worldPose("A", 0.0).position, Mat3::Identity());
-  pipeline::HandleRig pinnedRig(pinned.spec, &pinned.anim, pinned.sheet, 0.0);
+  model::HandleRig pinnedRig(pinned.spec, &pinned.anim, pinned.sheet, 0.0);
   pinnedRig.grips(0.0, kStiffness, grips);
   EXPECT_TRUE(grips.empty());
 }

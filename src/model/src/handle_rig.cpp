@@ -1,4 +1,4 @@
-#include "crumple/pipeline/handle_rig.hpp"
+#include "crumple/model/handle_rig.hpp"
 
 #include <Eigen/SVD>
 #include <algorithm>
@@ -9,7 +9,7 @@
 
 #include "crumple/core/error.hpp"
 
-namespace crumple::pipeline {
+namespace crumple::model {
 namespace {
 
 // Boundary vertices of the pattern: those on an edge with one triangle.
@@ -366,4 +366,4 @@ void HandleRig::restoreState(StateReader& in) {
   }
 }
 
-}  // namespace crumple::pipeline
+}  // namespace crumple::model

@@ -13,7 +13,7 @@
 #include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
 
-namespace crumple::pipeline {
+namespace crumple::model {
 
 struct BoundHandle {
   std::string name;
@@ -117,4 +117,4 @@ class HandleRig {
 // the number. Chosen among the one-ring by pattern direction, deterministic.
 std::vector<int> tangentNeighbours(const mesh::SheetMesh& sheet, int vertex, int count);
 
-}  // namespace crumple::pipeline
+}  // namespace crumple::model
