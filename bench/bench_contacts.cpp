@@ -1,4 +1,4 @@
-// What contacts cost (issue 5: "contact cost per frame for each sample and
+// What contacts cost ("contact cost per frame for each sample and
 // its share of the step"):
 //
 //   bench_contacts [SAMPLE ...] [--runs 3] [--json FILE]

@@ -1,5 +1,5 @@
-// The OSMesa preview's cost per frame at production resolution (issue 4:
-// "median time for one 1280x720 frame of the largest sample, under 50 ms").
+// The OSMesa preview's cost per frame at production resolution
+// ("median time for one 1280x720 frame of the largest sample, under 50 ms").
 //
 //   bench_preview [CACHE ...] [--width 1280] [--height 720] [--runs 15]
 //

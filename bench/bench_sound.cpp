@@ -1,4 +1,4 @@
-// What the soundtrack costs (issue 7: "synthesis speed as a multiple of real
+// What the soundtrack costs ("synthesis speed as a multiple of real
 // time per sample (target >= 200x) and the per-frame cost of events and
 // resonators"):
 //

@@ -1,4 +1,4 @@
-// What tearing costs (issue 6: "benchmark the tearing stage's cost per frame
+// What tearing costs ("benchmark the tearing stage's cost per frame
 // and quote it"):
 //
 //   bench_tear [SAMPLE ...] [--runs 3] [--json FILE]

@@ -1,5 +1,5 @@
-// Whole-shot benchmark of the hybrid crumpling model on the samples (issue 3,
-// "Benchmark"): per-stage milliseconds per frame (elastic, geometric, cone
+// Whole-shot benchmark of the hybrid crumpling model on the samples:
+// per-stage milliseconds per frame (elastic, geometric, cone
 // fitting, S_P rebuild, isometry), and the same motions simulated by the
 // plain elastic model on fixed meshes of decreasing edge length, with the
 // length error (c_mean, paper Table IV) each reaches. Medians of `--runs`

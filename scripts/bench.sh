@@ -15,6 +15,6 @@ build="${BUILD_DIR:-${CRUMPLE_BUILD_DIR:-$root/build}}"
 out="${OUT:-docs/bench}"  # relative to the source tree, as the report quotes it
 bash "$root/scripts/bootstrap.sh"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)" --target crumple
+cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)" --target crumple --target crumple-bench
 cd "$root"
 "$build/crumple" bench --out "$out" "$@"

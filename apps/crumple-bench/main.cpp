@@ -29,23 +29,23 @@ int main(int argc, char** argv) {
   bool noProjection = false;
   app.add_option("--out", options.outDir, "output folder")->capture_default_str();
   app.add_option("--samples", samples,
-                       "a,b,...: sample names under samples/ (paper-types/eps-0.5.toml for a "
-                       "variant; default: every sample)");
+                 "a,b,...: sample names under samples/ (paper-types/eps-0.5.toml for a "
+                 "variant; default: every sample)");
   app.add_option("--runs", options.runs,
-                   "timed runs per configuration, the median reported (a run over 10 s is "
-                   "timed once)")
+                 "timed runs per configuration, the median reported (a run over 10 s is "
+                 "timed once)")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
   app.add_option("--frames", options.lastFrame,
-                       "LAST: simulate every configuration up to frame LAST at most");
+                 "LAST: simulate every configuration up to frame LAST at most");
   app.add_flag("--quick", options.quick,
-                     "a small subset for tests: first-singularity and drape up to frame 24 (or "
-                     "--frames), one run, the hybrid model at 1 and 2 substeps, elastic 2 and "
-                     "1 cm meshes at 2");
+               "a small subset for tests: first-singularity and drape up to frame 24 (or "
+               "--frames), one run, the hybrid model at 1 and 2 substeps, elastic 2 and "
+               "1 cm meshes at 2");
   app.add_flag("--no-projection", noProjection,
-                     "skip paper Table III (the isometry projection against Shape-Up)");
+               "skip paper Table III (the isometry projection against Shape-Up)");
   app.add_option("--source", options.sourceDir,
-                       "the source tree whose samples/ are run (default: this build's)");
+                 "the source tree whose samples/ are run (default: this build's)");
 
   try {
     app.parse(argc, argv);

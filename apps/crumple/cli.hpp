@@ -1,5 +1,5 @@
 #pragma once
-// The `crumple` command line (DESIGN.md "The command line"): the options
+// The `crumple` command line (docs/ARCHITECTURE.md "The command line"): the options
 // every command fills, and the commands. Exit status: 0 success, 1 internal
 // failure (including a numerical failure that survived substep halving), 2
 // bad input.

@@ -1,4 +1,4 @@
-// The `crumple` command line (DESIGN.md "The command line"): the commands
+// The `crumple` command line (docs/ARCHITECTURE.md "The command line"): the commands
 // and their options, and the exit status each outcome maps to: 0 success, 1
 // internal failure (including a numerical failure that survived substep
 // halving), 2 bad input. `crumple bench` runs crumple-bench, built beside
@@ -81,18 +81,17 @@ void addShotCommands(CLI::App& app, Args& a, Commands& c) {
 
 // `render`: frames of a cache.
 void addRenderCommand(CLI::App& app, Args& a, Commands& c) {
-  c.render =
-      app.add_subcommand("render", "Render frames of a cache (frame-parallel farm work).");
+  c.render = app.add_subcommand("render", "Render frames of a cache (frame-parallel farm work).");
   c.render->add_flag("--debug-structure", a.debugStructure,
-                   "draw the crumpling model's structure (see `run --help`)");
+                     "draw the crumpling model's structure (see `run --help`)");
   c.render->add_option("CACHE", a.cache, "a .pcache file")->required();
   c.render->add_option("--frames", a.frames, "A-B: frames to render (default: every cached frame)");
   addRenderOptions(c.render, a);
   c.render->add_option("--out", a.out,
-                     "frames folder (default: frames/ beside the cache); locked while rendering "
-                     "(exit 2 when another crumple writes there), shared by renders of a "
-                     "--frames range (a farm's array tasks)");
-  render
+                       "frames folder (default: frames/ beside the cache); locked while rendering "
+                       "(exit 2 when another crumple writes there), shared by renders of a "
+                       "--frames range (a farm's array tasks)");
+  c.render
       ->add_option("--threads", a.threads,
                    "embree: worker threads (the images are identical for any count); osmesa: "
                    "the rasteriser sizes its own threads (LP_NUM_THREADS), identical images too")
@@ -108,25 +107,27 @@ void addCacheCommands(CLI::App& app, Args& a, Commands& c) {
       "exactly frame_count / fps, and its spectrogram PNG beside it.");
   c.soundCmd->add_option("CACHE", a.cache, "a .pcache file")->required();
   c.soundCmd->add_option("--out", a.out,
-                       "the WAV file, or a folder to write sound.wav into (default: sound.wav "
-                       "beside the cache); its folder is locked while writing (exit 2 when "
-                       "another crumple writes there)");
-  soundCmd
+                         "the WAV file, or a folder to write sound.wav into (default: sound.wav "
+                         "beside the cache); its folder is locked while writing (exit 2 when "
+                         "another crumple writes there)");
+  c.soundCmd
       ->add_option("--rate", a.rate, "sample rate: 48000 or 44100 (default: the scene's, 48000)")
       ->check(CLI::IsMember({48000, 44100}));
-  c.soundCmd->add_option("--format", a.format,
-                       "pcm24 (24-bit PCM) or float (32-bit float) (default: the scene's, pcm24)");
-  c.soundCmd->add_option("--channels", a.channels, "1 (mono) or 2 (stereo) (default: the scene's, 2)")
+  c.soundCmd->add_option(
+      "--format", a.format,
+      "pcm24 (24-bit PCM) or float (32-bit float) (default: the scene's, pcm24)");
+  c.soundCmd
+      ->add_option("--channels", a.channels, "1 (mono) or 2 (stereo) (default: the scene's, 2)")
       ->check(CLI::IsMember({1, 2}));
   c.soundCmd->add_option("--database", a.database,
-                       "sound database folder (default: the scene's [sound] database, else "
-                       "assets/sound/default)");
+                         "sound database folder (default: the scene's [sound] database, else "
+                         "assets/sound/default)");
   c.soundCmd->add_option("--gain-db", a.gainDb,
-                       "a fixed gain in dB, -200 ... 200 (default: the mix's peak normalised to "
-                       "-1 dBFS)");
+                         "a fixed gain in dB, -200 ... 200 (default: the mix's peak normalised to "
+                         "-1 dBFS)");
   c.soundCmd->add_flag("--no-spectrogram", a.noSpectrogram, "do not write the PNG");
   c.soundCmd->add_flag("--events", a.listEvents,
-                     "print the cache's sound events, one line each, and make no sound");
+                       "print the cache's sound events, one line each, and make no sound");
   c.compare = app.add_subcommand(
       "compare",
       "Compare two images (PNG, or EXR as sRGB) for golden-image tests, writing a diff image; "
@@ -136,16 +137,16 @@ void addCacheCommands(CLI::App& app, Args& a, Commands& c) {
   c.compare->add_option("A", a.imageA, "reference image or cache")->required();
   c.compare->add_option("B", a.imageB, "image or cache under test")->required();
   c.compare->add_option("--shape-tolerance", a.shapeTolerance,
-                      "caches: pass when every frame's mean distance is at most this (m)");
+                        "caches: pass when every frame's mean distance is at most this (m)");
   c.compare->add_option("--frames", a.frames,
-                      "caches: A-B, the frames to compare (default: all shared)");
+                        "caches: A-B, the frames to compare (default: all shared)");
   c.compare->add_flag("--json", a.json, "caches: one JSON object for scripts");
-  compare
+  c.compare
       ->add_option("--metric", a.metric,
                    "mae: mean |difference| over RGBA in 8-bit units; psnr: dB over RGBA; flip: "
                    "mean LDR-FLIP error in [0, 1] (Andersson et al. 2020) of the images over grey")
       ->capture_default_str();
-  compare
+  c.compare
       ->add_option("--tolerance", a.tolerance,
                    "pass when mae/flip <= tolerance, or psnr >= tolerance")
       ->capture_default_str();
@@ -156,9 +157,9 @@ void addCacheCommands(CLI::App& app, Args& a, Commands& c) {
       "against its handles' motion, docs/CRUMPLING.md) of a cache.");
   c.inspect->add_option("CACHE", a.cache, "a .pcache file")->required();
   c.inspect->add_flag("--json", a.json,
-                    "one JSON object for scripts; per frame also how far the sheet passes into "
-                    "itself (self_depth in thicknesses, self_crossings) and the crumpling "
-                    "model's structure changes (structure_changes)");
+                      "one JSON object for scripts; per frame also how far the sheet passes into "
+                      "itself (self_depth in thicknesses, self_crossings) and the crumpling "
+                      "model's structure changes (structure_changes)");
   c.exportCmd = app.add_subcommand(
       "export",
       "Export cached frames for DCC tools (docs/EXPORT.md): obj (NNNN.obj + .mtl, UVs = the "
@@ -167,12 +168,13 @@ void addCacheCommands(CLI::App& app, Args& a, Commands& c) {
       "(shot.usda, a time-varying Mesh). Needs only the cache.");
   c.exportCmd->add_option("CACHE", a.cache, "a .pcache file")->required();
   c.exportCmd->add_option("--format", a.exportFormat, "obj, ply, gltf or usda")->required();
-  c.exportCmd->add_option("--out", a.out,
-                        "output folder (default: export/<format>/ beside the cache); locked while "
-                        "writing (exit 2 when another crumple writes there), shared by exports "
-                        "of a --frames range");
+  c.exportCmd->add_option(
+      "--out", a.out,
+      "output folder (default: export/<format>/ beside the cache); locked while "
+      "writing (exit 2 when another crumple writes there), shared by exports "
+      "of a --frames range");
   c.exportCmd->add_option("--frames", a.frames,
-                        "A-B: frames to export (default: every cached frame)");
+                          "A-B: frames to export (default: every cached frame)");
 }
 
 // `farm slurm` and `farm movie`.
@@ -186,26 +188,26 @@ void addFarmCommand(CLI::App& app, Args& a, Commands& c) {
       "the whole array; prints the job ids.");
   c.farmSlurm->add_option("SCENE", a.scene, "scene.toml, or a folder holding one")->required();
   c.farmSlurm->add_option("--out", a.slurm.outDir,
-                        "the shot folder (default: the scene's [output] dir, else "
-                        "out/<scene name>)");
+                          "the shot folder (default: the scene's [output] dir, else "
+                          "out/<scene name>)");
   c.farmSlurm->add_option("--chunk", a.slurm.chunk, "frames per render array task")
       ->capture_default_str();
   c.farmSlurm->add_option("--partition", a.slurm.partition, "sbatch --partition of every job");
   c.farmSlurm->add_option("--time", a.slurm.time, "sbatch --time of every job (e.g. 1:00:00)");
-  farmSlurm
+  c.farmSlurm
       ->add_option("--cpus-per-task", a.slurm.cpusPerTask,
                    "sbatch --cpus-per-task of every job, and its crumple --threads")
       ->check(CLI::PositiveNumber);
   c.farmSlurm->add_option("--mem", a.slurm.mem, "sbatch --mem of every job (e.g. 4G)");
   c.farmSlurm->add_option("--render-args", a.slurm.renderArgs,
-                        "more `crumple render` arguments for every array task, as one word: "
-                        "--render-args=\"--backend embree --spp 64\"");
+                          "more `crumple render` arguments for every array task, as one word: "
+                          "--render-args=\"--backend embree --spp 64\"");
   c.farmSlurm->add_option("--crumple", a.slurm.crumple,
-                        "the crumple binary the jobs run (default: this one)");
+                          "the crumple binary the jobs run (default: this one)");
   c.farmSlurm->add_flag("--no-movie{false}", a.slurm.movie,
-                      "finalize makes no preview.mp4 (it makes it by default, with ffmpeg)");
+                        "finalize makes no preview.mp4 (it makes it by default, with ffmpeg)");
   c.farmSlurm->add_flag("--dry-run", a.dryRun,
-                      "print the scripts and the sbatch command lines; write and submit nothing");
+                        "print the scripts and the sbatch command lines; write and submit nothing");
   auto* farmMovie = c.farm->add_subcommand(
       "movie",
       "The finalize job's movie: preview.mp4 beside the cache from the frames already in "
@@ -217,17 +219,9 @@ void addFarmCommand(CLI::App& app, Args& a, Commands& c) {
 void addBenchCommand(CLI::App& app, Args& /*a*/, Commands& c) {
   c.bench = app.add_subcommand(
       "bench",
-      "Speed against error (docs/BENCH.md): every sample at its own settings, and on the "
-      "paper's examples (cylinder-fold, first-singularity, unload, moebius) the "
-      "hybrid model at 1, 2, 4, 8 substeps, and at 1 and 2 with 1000, 3000, 10000 and 30000 "
-      "isometry length sweeps, against the elastic model on fixed 2 and 1 cm "
-      "meshes at 1, 2, 4 substeps, 0.5 cm at 2 and 4, and on first-singularity (Table II) "
-      "0.25 cm at 2; ms per frame by "
-      "stage beside c_mean, n_comp, angle defect, handle error and the tear errors. One "
-      "thread. Writes DIR/bench.csv, DIR/pareto.png (gnuplot) with each model's Pareto "
-      "front, DIR/report.md beside the paper's Tables II-V (and DIR/table3.csv). About 20 "
-      "minutes with the defaults (30 at most). Runs crumple-bench (beside this binary); "
-      "`crumple bench --help` lists its options.");
+      "Speed against error (docs/BENCH.md): every sample's cost per frame by stage beside its "
+      "error measures, and each model's Pareto front. Runs crumple-bench (beside this binary): "
+      "`crumple bench --help` lists what it measures and its options.");
   c.bench->allow_extras();
 }
 
@@ -235,8 +229,8 @@ void addBenchCommand(CLI::App& app, Args& /*a*/, Commands& c) {
 int runBench(int argc, char** argv) {
   std::error_code ec;
   const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
-  const std::filesystem::path bench = (ec ? std::filesystem::path(argv[0]) : self)
-                                          .parent_path() / "crumple-bench";
+  const std::filesystem::path bench =
+      (ec ? std::filesystem::path(argv[0]) : self).parent_path() / "crumple-bench";
   std::vector<std::string> words{bench.string()};
   for (int i = 2; i < argc; ++i) words.emplace_back(argv[i]);
   std::vector<char*> args;

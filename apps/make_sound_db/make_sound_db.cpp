@@ -1,7 +1,7 @@
 // make_sound_db OUT_DIR: writes the generated default sound database (thesis
 // 4.3.3; docs/SOUND.md "The default database") into OUT_DIR. The shipped
 // assets/sound/default is its output: scripts/make-sound-db.sh regenerates it.
-// Exit status (DESIGN.md "The command line"): 0 written, 2 bad usage or an
+// Exit status (docs/ARCHITECTURE.md "The command line"): 0 written, 2 bad usage or an
 // OUT_DIR that is not empty (without --force), 1 a failure while writing.
 #include <cstdio>
 #include <exception>

@@ -1,5 +1,5 @@
 #pragma once
-// `crumple bench` (issue 9, docs/BENCH.md): every sample at its own settings,
+// `crumple bench` (docs/BENCH.md): every sample at its own settings,
 // and on the paper's examples the hybrid model at several substep counts and
 // isometry length sweeps against the plain elastic model on fixed meshes at
 // several resolutions;

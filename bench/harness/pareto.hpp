@@ -1,5 +1,5 @@
 #pragma once
-// Speed against error (issue 9): each model's Pareto front in the plane
+// Speed against error: each model's Pareto front in the plane
 // (error, ms per frame), and the verdict whether the hybrid model's front
 // lies below the plain elastic model's.
 #include <optional>

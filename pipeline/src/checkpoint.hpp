@@ -1,5 +1,5 @@
 #pragma once
-// Checkpoint files (issue 8): a shot's whole simulation state after a frame,
+// Checkpoint files: a shot's whole simulation state after a frame,
 // DIR/checkpoint.bin, written atomically (PATH.tmp, fsync, rename), checked
 // by a CRC32 and by the shot it belongs to (scene text, the content of every
 // other file that shapes it, seed, frame range). Internal to the pipeline;

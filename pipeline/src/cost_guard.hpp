@@ -4,7 +4,9 @@
 // their substeps, stop the shot with a NumericalError naming the frame, the
 // stage and the likely cause, instead of a silent crawl that bills a farm
 // node for hours. The cache stays valid up to the last good frame (the
-// shot's numerical-failure path). Internal to the pipeline.
+// shot's numerical-failure path). Its seconds are the process's CPU time
+// (core/work_budget.hpp): a machine loaded by other work does not stop a
+// shot. Internal to the pipeline.
 #include <optional>
 #include <string>
 #include <vector>

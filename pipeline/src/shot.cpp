@@ -38,9 +38,9 @@ void detail::prepareOutputDir(const std::string& dir, const std::string& what) {
 }
 
 void detail::finishFrames(const std::string& framesDir, const FrameRange& range, double fps,
-                  const std::string& shotDir, const RenderSettings& settings,
-                  std::string& contactSheetPath, std::string& moviePath,
-                  std::vector<std::string>& notes) {
+                          const std::string& shotDir, const RenderSettings& settings,
+                          std::string& contactSheetPath, std::string& moviePath,
+                          std::vector<std::string>& notes) {
   const fs::path dir = shotDir.empty() ? fs::path(".") : fs::path(shotDir);
   if (settings.contactSheet) {
     contactSheetPath = (dir / "contact_sheet.png").string();
@@ -49,8 +49,8 @@ void detail::finishFrames(const std::string& framesDir, const FrameRange& range,
   if (settings.movie) {
     std::string note;
     const std::string movie = (dir / "preview.mp4").string();
-    if (makeMovie(framesDir, range.first, range.last, fps, (dir / "sound.wav").string(),
-                          movie, note))
+    if (makeMovie(framesDir, range.first, range.last, fps, (dir / "sound.wav").string(), movie,
+                  note))
       moviePath = movie;
     if (!note.empty()) notes.push_back(note);
   }
@@ -142,14 +142,14 @@ RenderReport renderCache(const std::string& cachePath, const RenderOptions& opti
     progress.update(f - range.first + 1);
   }
   progress.finish();
-  detail::finishFrames(report.framesDir, range, scene.fps, fs::path(cachePath).parent_path().string(),
-               options.rendering, report.contactSheetPath, report.moviePath, report.notes);
+  detail::finishFrames(report.framesDir, range, scene.fps,
+                       fs::path(cachePath).parent_path().string(), options.rendering,
+                       report.contactSheetPath, report.moviePath, report.notes);
   return report;
 }
 
 const char* backendName(RenderSettings::Backend backend) {
   return backend == RenderSettings::Backend::Embree ? "embree" : "osmesa";
 }
-
 
 }  // namespace crumple::pipeline

@@ -16,7 +16,7 @@
 namespace crumple::pipeline {
 
 struct ShotPlan {
-  // Where: DIR and the files in it (DESIGN.md "The command line").
+  // Where: DIR and the files in it (docs/ARCHITECTURE.md "The command line").
   std::string outDir, cachePath, summaryPath, checkpointPath;
   std::string framesDir;  // empty: nothing is rendered
   // Which frames: simulated from firstFrame to lastFrame, rendered from

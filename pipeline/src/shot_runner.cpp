@@ -16,10 +16,8 @@ namespace crumple::pipeline {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+// The cost guard's clock: the process's CPU time (core/work_budget.hpp).
+double cpuSecondsSince(double start) { return processCpuSeconds() - start; }
 
 // A handle further than this from its node lags (strain_limit.hpp).
 constexpr double kLagReported = 1e-6;
@@ -71,7 +69,8 @@ ShotRunner::ShotRunner(const io::SceneSpec& scene, const ShotOptions& options)
     : scene_(scene), plan_(planShot(scene, options)), guard_(plan_.frameBudget) {
   report_.outDir = plan_.outDir;
   if (!scene.animationFile.empty()) {
-    animation_ = std::make_unique<io::AnimationScene>(io::AnimationScene::load(scene.animationFile));
+    animation_ =
+        std::make_unique<io::AnimationScene>(io::AnimationScene::load(scene.animationFile));
     io::checkAnimationNodes(scene, *animation_);
   }
   // What a checkpoint records of the files read (docs/CHECKPOINT.md), hashed as they were read.
@@ -178,23 +177,23 @@ ShotReport ShotRunner::run() {
     firstFrame = resumed_->frame + 1;
   }
   int frame = firstFrame;
-  Clock::time_point frameStart = Clock::now();
+  double frameStart = processCpuSeconds();
   try {
     if (!resumed_) recordFrame(plan_.firstFrame);
     for (; frame <= plan_.lastFrame; ++frame) {
-      frameStart = Clock::now();
+      frameStart = processCpuSeconds();
       const long halvingsBefore = report_.halvings;
       const ScopedWorkBudget frameBudget(guard_.budget());
       step(frame);
       if (tearStage_) tear(frame);
       recordFrame(frame);
       if (plan_.checkpointAfter(frame)) checkpoint(frame);
-      guard_.frameDone(frame, secondsSince(frameStart), report_.halvings - halvingsBefore,
+      guard_.frameDone(frame, cpuSecondsSince(frameStart), report_.halvings - halvingsBefore,
                        costCause(frame));
       if (report_.tearHandoverFrame == frame) guard_.newRegime();
     }
   } catch (const NumericalError& caught) {
-    fail(caught, std::min(frame, plan_.lastFrame), secondsSince(frameStart));
+    fail(caught, std::min(frame, plan_.lastFrame), cpuSecondsSince(frameStart));
   }
   finish();
   return report_;
@@ -235,7 +234,8 @@ void ShotRunner::step(int frame) {
     r.stages[name].frames += 1;
   }
   structureBlock_.reset();
-  if (s.structure) structureBlock_ = cache::encodeStructureChanges(cacheStructureChanges(*s.structure));
+  if (s.structure)
+    structureBlock_ = cache::encodeStructureChanges(cacheStructureChanges(*s.structure));
 }
 
 // The tearing stage (model::TearStage), and the tear textures in the cache.
@@ -336,8 +336,7 @@ std::string ShotRunner::costCause(int frame) const {
 // the cache stays valid up to the last good frame.
 void ShotRunner::fail(const NumericalError& caught, int frame, double frameSeconds) {
   const double budget = guard_.budget();
-  const bool overBudget =
-      budget > 0.0 && frameSeconds >= budget && caught.stage() != "cost guard";
+  const bool overBudget = budget > 0.0 && frameSeconds >= budget && caught.stage() != "cost guard";
   const NumericalError e =
       overBudget ? guard_.budgetError(frame, caught.stage(), costCause(frame)) : caught;
   progress_->finish();

@@ -109,7 +109,7 @@ TEST(Progress, WritesOneLinePerStepOrNothingWithoutAStream) {
   quiet.finish();
 }
 
-// The checkpoint's byte layer (issue 8): everything written reads back bit
+// The checkpoint's byte layer: everything written reads back bit
 // for bit; a wrong section, a short state or a huge count is refused.
 TEST(StateIo, RoundTripsAndRefusesDamage) {
   StateWriter w;

@@ -263,7 +263,7 @@ TEST_F(PcacheTest, WriterDestroyedWithoutCloseLeavesRecoverableFrames) {
   }
 }
 
-// Checkpoint and resume (issue 8): a cache cut anywhere after frame k (a
+// Checkpoint and resume: a cache cut anywhere after frame k (a
 // killed run: later frames, a torn chunk, or a finished file's footer) and
 // resumed from k frames, then given the same frames, is byte for byte the
 // uninterrupted cache; the topology shared across the cut is stored once.

@@ -34,7 +34,7 @@ constexpr int kEmbreeSpp = 8;
 // compiler differences between machines.
 constexpr double kEmbreeMaxMae = 0.5;    // mean |difference| over RGBA, 8-bit units
 constexpr double kEmbreeMaxFlip = 0.01;  // mean LDR-FLIP
-// The agreement of the two backends (issue 4): albedo passes at 320 x 240.
+// The agreement of the two backends: albedo passes at 320 x 240.
 constexpr int kAgreeWidth = 320;
 constexpr int kAgreeHeight = 240;
 constexpr int kAgreeSpp = 16;

@@ -6,12 +6,12 @@
 #include <cmath>
 #include <numbers>
 
+#include "../pipeline/test_util.hpp"
 #include "crumple/io/animation.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/model/handle_rig.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
-#include "../pipeline/test_util.hpp"
 
 using namespace crumple;
 using namespace crumple::testing;

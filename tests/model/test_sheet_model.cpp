@@ -27,8 +27,8 @@ struct Sample {
   std::unique_ptr<io::AnimationScene> animation;
   explicit Sample(const std::string& name)
       : scene(io::loadScene(io::resolveScenePath(sourcePath("samples/" + name)))),
-        animation(std::make_unique<io::AnimationScene>(
-            io::AnimationScene::load(scene.animationFile))) {}
+        animation(
+            std::make_unique<io::AnimationScene>(io::AnimationScene::load(scene.animationFile))) {}
   model::ShotSheet setUp() const {
     model::ModelContext c;
     c.material = model::materialOf(scene.paper);
@@ -54,7 +54,8 @@ TEST(SheetModel, TheSceneChoosesTheModel) {
   EXPECT_FALSE(elastic.model->singularCounts().has_value());
   EXPECT_TRUE(elastic.model->structure().rulings.empty());
   EXPECT_FALSE(elastic.model->remeshes());
-  EXPECT_EQ(elastic.model->mesh().vertexCount(), model::buildSheet(drape.scene, nullptr).vertexCount());
+  EXPECT_EQ(elastic.model->mesh().vertexCount(),
+            model::buildSheet(drape.scene, nullptr).vertexCount());
 
   const Sample fold("cylinder-fold");
   const model::ShotSheet crumpling = fold.setUp();

@@ -128,7 +128,7 @@ TEST(HybridSheet, Deterministic) {
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i], b[i]);
 }
 
-// Issue 6: a tear cuts S_G (HybridSheet::tear) and the model goes on with
+// Tearing: a tear cuts S_G (HybridSheet::tear) and the model goes on with
 // the torn sheet. The two bottom corners are drawn apart: S_G stays valid
 // at every sub-step (checkInvariants), the lips at the slit's mouth open in
 // 3D, and the tip stays an S_G vertex on the outline. The corners end
@@ -272,7 +272,7 @@ TEST(HybridSheet, ALaggingHandleComesBackAtTheCatchUpSpeed) {
   EXPECT_GT(jump, 3e-3);  // the whole lag in one frame
 }
 
-// Hard cases for issue 6: the wrap of WrapCreatesParallelRulingsAndStaysIsometric
+// Hard cases for tearing: the wrap of WrapCreatesParallelRulingsAndStaysIsometric
 // torn halfway through, from 9 points of its bottom edge in 3 directions
 // (through its curved region: the structure cases 1-2, and its flat ones),
 // then wrapped on to the end with every invariant checked at every sub-step.

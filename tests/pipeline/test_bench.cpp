@@ -1,4 +1,4 @@
-// `crumple bench` (issue 9, docs/BENCH.md): the Pareto fronts and their
+// `crumple bench` (docs/BENCH.md): the Pareto fronts and their
 // verdict on hand-made points, the angle defect (developability) of
 // pipeline::measureFrame on hand-made meshes, and a `bench --quick` run that
 // writes the CSV with both models' rows, the plot and the report.

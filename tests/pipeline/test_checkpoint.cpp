@@ -1,4 +1,4 @@
-// Checkpoint and resume (issue 8, item 3): a run killed with SIGKILL at a
+// Checkpoint and resume: a run killed with SIGKILL at a
 // random frame and resumed from its last checkpoint writes a cache
 // byte-identical to an uninterrupted run's; checkpoints do not change the
 // cache; a checkpoint of another shot, a damaged one or none is refused.

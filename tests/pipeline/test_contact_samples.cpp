@@ -1,4 +1,4 @@
-// Scene-level tests of contacts on the samples of issue 5 (slide-on-table,
+// Scene-level tests of contacts on its samples (slide-on-table,
 // press-on-sphere, fold-over): at every frame no free vertex lies deeper
 // than 10 % of the paper's thickness inside a collider or inside the sheet,
 // measured from the cache with the colliders at the frame's time; the sheet

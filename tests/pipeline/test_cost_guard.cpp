@@ -68,8 +68,7 @@ TEST(CostGuard, ANewRegimeIsJudgedAgainstItsOwnFrames) {
   EXPECT_DOUBLE_EQ(guard.budget(), CostGuard::kRunawayFactor * 12.0);
   CostGuard same(std::nullopt);
   for (int f = 0; f < 10; ++f) same.frameDone(f, 0.2, 0, "");
-  EXPECT_THROW(
-      for (int f = 10; f < 20; ++f) same.frameDone(f, 12.0, 0, ""), NumericalError);
+  EXPECT_THROW(for (int f = 10; f < 20; ++f) same.frameDone(f, 12.0, 0, ""), NumericalError);
 }
 
 TEST(CostGuard, ItStopsAfterFramesInARowThatKeepHalving) {

@@ -1,5 +1,5 @@
 // Scene-level tests of the hybrid crumpling model on the samples that
-// reproduce the seeds' experiments (issue 3 acceptance). Each asserts the
+// reproduce the seeds' experiments (docs/CRUMPLING.md). Each asserts the
 // property over every simulated frame, with the region invariants checked
 // after every geometric step (--debug invariants).
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// `crumple export` on real shots (issue 8, docs/EXPORT.md): the crumple
+// `crumple export` on real shots (docs/EXPORT.md): the crumple
 // sample (its topology changes as it crumples) exported in every format
 // through the CLI and re-read with assimp, frame by frame against the cache
 // (vertex and face counts, every corner's position, bounds, UVs in [0, 1]);

@@ -119,7 +119,7 @@ TEST(Shot, HandlesTrackTheirCurvesForEveryFormat) {
     const cache::CacheReader reader(report.cachePath);
     // The tangent-plane vertices (3 on a border) follow the node's rotation.
     const auto held = model::tangentNeighbours(model::buildSheet(spec, &anim),
-                                                  reader.readFrame(0).handleVertices[0], 0);
+                                               reader.readFrame(0).handleVertices[0], 0);
     EXPECT_EQ(held.size(), 3u);
     std::vector<Vec3> traj;
     for (std::size_t i = 0; i < reader.frameCount(); ++i) {
@@ -421,7 +421,7 @@ TEST(HandleRig, SaysHowFarAHandleIsFromItsVertex) {
   const auto good = io::loadScene((tmp / "ok/scene.toml").string());
   const auto goodAnim = io::AnimationScene::load(good.animationFile);
   const model::HandleRig exact(good, &goodAnim, model::buildSheet(good, &goodAnim),
-                                  good.frameTime(good.frameStart));
+                               good.frameTime(good.frameStart));
   EXPECT_EQ(count(exact.bindWarnings(), "pattern point"), 0);
 }
 

@@ -1,4 +1,4 @@
-// Scene-level tests of the soundtrack (issue 7) on its samples: wiggle
+// Scene-level tests of the soundtrack on its samples: wiggle
 // flaps, a crumpled sheet clacks, slide-on-table rubs while sliding and
 // flaps when its back stands up, the friction's centroid rises as the sheet
 // shrinks (A4 > A5 > A6), a faster tear is louder and crackles more, and

@@ -1,4 +1,4 @@
-// Collider proximity queries (issue 5, item 1): analytic planes, boxes and
+// Collider proximity queries: analytic planes, boxes and
 // spheres, FCL-backed meshes, animated poses.
 #include <gtest/gtest.h>
 
@@ -137,7 +137,7 @@ TEST(Colliders, RejectsDegenerateShapes) {
   EXPECT_THROW(set.setPose(0, at(Vec3::Zero())), std::out_of_range);
 }
 
-// --- contacts in the elastic step (issue 5, item 2) -----------------------------
+// --- contacts in the elastic step -----------------------------
 
 // A 10 cm sheet lying flat at height y, front side up.
 mesh::SheetMesh flatSheet(double y, double maxEdge = 0.02) {

@@ -554,7 +554,7 @@ TEST(ElasticSheet, HingeFoldedPastPiUnfoldsTheWayItCame) {
   EXPECT_LT(sheet.bendingEnergy(), 1e-15);
 }
 
-// Issue 6 (tearing, thesis 3.3.3): the membrane force of each triangle on a
+// Tearing (thesis 3.3.3): the membrane force of each triangle on a
 // vertex is minus its energy gradient; summed, they are minus the sheet's
 // membrane energy gradient at that vertex (checked by central differences),
 // and a sheet stretched along X pulls its right edge back to the left.
@@ -590,7 +590,7 @@ TEST(ElasticSheet, MembraneForcesOnAVertexAreMinusTheEnergyGradient) {
   EXPECT_THROW(sheet.membraneForcesOn(-1), std::out_of_range);
 }
 
-// Checkpoint and resume (issue 8): a sheet rebuilt on the same mesh and
+// Checkpoint and resume: a sheet rebuilt on the same mesh and
 // given the saved state goes on bit for bit as the one that never stopped;
 // a state for another mesh is refused.
 TEST(ElasticSheet, ASavedStateGoesOnBitForBit) {

@@ -14,9 +14,11 @@
 #include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
 #include "crumple/sim/energies.hpp"
+#include "fd_check.hpp"
 
 using namespace crumple;
 using namespace crumple::sim;
+using namespace crumple::testing;
 
 namespace {
 
@@ -26,57 +28,6 @@ std::string sci(double v) {  // measured figures for the gtest XML report
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3e", v);
   return buf;
-}
-
-// norm(analytic - fd) / max(norm(fd), floor)
-template <typename A, typename B>
-double relativeError(const A& analytic, const B& fd, double floor) {
-  return (analytic - fd).norm() / std::max(fd.norm(), floor);
-}
-
-struct Random {
-  CounterRng rng;
-  std::uint64_t next = 0;
-  explicit Random(std::uint64_t seed) : rng(seed, 0, RngPurpose::Generic) {}
-  double uniform(double lo, double hi) { return lo + (hi - lo) * rng.uniform(next++); }
-  Vec3 vec3(double scale) {
-    const double a = uniform(-1, 1), b = uniform(-1, 1), c = uniform(-1, 1);
-    return scale * Vec3(a, b, c);
-  }
-  Mat3 rotation() {
-    const double a = uniform(-1, 1), b = uniform(-1, 1), c = uniform(-1, 1), d = uniform(-1, 1);
-    return Quat(a, b, c, d).normalized().toRotationMatrix();
-  }
-};
-
-// Central differences of a scalar function of N coordinates.
-template <int N>
-Eigen::Matrix<double, N, 1> fdGradient(
-    const std::function<double(const Eigen::Matrix<double, N, 1>&)>& f,
-    const Eigen::Matrix<double, N, 1>& x, double eps) {
-  Eigen::Matrix<double, N, 1> g;
-  for (int i = 0; i < N; ++i) {
-    Eigen::Matrix<double, N, 1> xp = x, xm = x;
-    xp[i] += eps;
-    xm[i] -= eps;
-    g[i] = (f(xp) - f(xm)) / (2.0 * eps);
-  }
-  return g;
-}
-
-// Central differences of a gradient (columns of the Hessian).
-template <int N>
-Eigen::Matrix<double, N, N> fdHessian(
-    const std::function<Eigen::Matrix<double, N, 1>(const Eigen::Matrix<double, N, 1>&)>& g,
-    const Eigen::Matrix<double, N, 1>& x, double eps) {
-  Eigen::Matrix<double, N, N> h;
-  for (int i = 0; i < N; ++i) {
-    Eigen::Matrix<double, N, 1> xp = x, xm = x;
-    xp[i] += eps;
-    xm[i] -= eps;
-    h.col(i) = (g(xp) - g(xm)) / (2.0 * eps);
-  }
-  return h;
 }
 
 Material officePaper() { return Material{}; }  // the office-70gsm preset

@@ -1,4 +1,4 @@
-// Self-contact of the sheet (issue 5, item 3): the FCL broad phase and the
+// Self-contact of the sheet: the FCL broad phase and the
 // exact vertex-triangle narrow phase, the fold gate, and a flap that falls
 // onto its own sheet in the elastic step.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// A crumpling event's sound (issue 7, item 4) and the soundtrack's sync
+// A crumpling event's sound and the soundtrack's sync
 // (the issue's acceptance: one event placed at a known frame has its onset
 // in the WAV within 1 ms of that frame's time).
 #include <gtest/gtest.h>

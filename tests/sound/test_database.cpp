@@ -1,4 +1,4 @@
-// The sound database's loader (issue 7, item 3): a small database built from
+// The sound database's loader: a small database built from
 // WAVs and spectra the test writes, read back, looked up; and every way an
 // index or a file can be wrong, named.
 #include <gtest/gtest.h>

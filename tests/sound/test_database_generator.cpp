@@ -1,4 +1,4 @@
-// The generated default sound database (issue 7, item 3; docs/SOUND.md "The
+// The generated default sound database (docs/SOUND.md "The
 // default database"): the shipped assets/sound/default loads, has the
 // thesis' grid, and is byte for byte what make_sound_db makes; clacs are
 // short and flaps long; friction spectra move up as the resonator shrinks;

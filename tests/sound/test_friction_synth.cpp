@@ -1,4 +1,4 @@
-// Friction noise from power spectra (issue 7, item 4): its level follows the
+// Friction noise from power spectra: its level follows the
 // spectrum, its colour follows the spectrum, its blocks join without clicks,
 // and it repeats for a seed.
 #include <gtest/gtest.h>
@@ -99,7 +99,7 @@ TEST(FrictionSynth, ItsColourFollowsTheSpectrum) {
   EXPECT_GT(high, 2.5 * low);
 }
 
-// No clicks at block joins (issue 7's acceptance): in a steady stretch, the
+// No clicks at block joins: in a steady stretch, the
 // largest sample-to-sample step at a join stays within 4 standard
 // deviations of the stretch's own steps.
 TEST(FrictionSynth, BlocksJoinWithoutClicks) {

@@ -1,4 +1,4 @@
-// Spatialisation (thesis 4.3.4; issue 7, item 5): the dipole's lobe and
+// Spatialisation (thesis 4.3.4): the dipole's lobe and
 // distance law, the table's image source, its comb in friction spectra
 // (the notches move with the height above the table: the issue's
 // acceptance) and its delayed copy of crumpling clips.

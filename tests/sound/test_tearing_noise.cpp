@@ -1,4 +1,4 @@
-// The sound of a tear (thesis 4.4.1; issue 7, item 4).
+// The sound of a tear (thesis 4.4.1).
 #include <gtest/gtest.h>
 
 #include <algorithm>

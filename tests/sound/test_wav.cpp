@@ -1,4 +1,4 @@
-// The soundtrack's clock and WAV files (issue 7, item 6).
+// The soundtrack's clock and WAV files.
 #include <gtest/gtest.h>
 
 #include <algorithm>

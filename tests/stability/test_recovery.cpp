@@ -1,4 +1,4 @@
-// The stability fixes (issue 9; docs/STABILITY.md "Fixes made for the
+// The stability fixes (docs/STABILITY.md "Fixes made for the
 // suite") at unit level: the elastic step's recovery after a failure at every
 // halving, and the handles held within the sheet's reach.
 #include <gtest/gtest.h>

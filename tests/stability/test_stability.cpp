@@ -1,4 +1,4 @@
-// The stability suite (issue 9, item 3; docs/STABILITY.md): hard cases, each
+// The stability suite (docs/STABILITY.md): hard cases, each
 // a scene in tests/stability/scenes/, run through the `crumple` CLI under a
 // time limit with both sheet models. Every case must end with finite
 // positions, valid meshes and bounded length and handle errors on every

@@ -1,4 +1,4 @@
-// The tearing primitives (issue 6, thesis 3.2.2 and 3.3): the fibers'
+// The tearing primitives (thesis 3.2.2 and 3.3): the fibers'
 // texture, the Griffith criterion and the tip's propagation, the clustering
 // of the tip's forces into two pulls, and the detail path.
 #include <gtest/gtest.h>
@@ -154,7 +154,7 @@ TEST(Griffith, ForcesAtATipSplitIntoTheirTwoPulls) {
 
 TEST(DetailPath, RunsFromTipToTipRougherThanTheStraightSegment) {
   // At the default resolution (0.25 mm texels, 2 mm features, p = 0.5): the
-  // acceptance of issue 6 asks for at least 1.15 times the straight length
+  // tear paths must be at least 1.15 times the straight length
   // between tips. 2 cm segments in 8 directions, fiber seeds 1-4.
   for (std::uint64_t seed = 1; seed <= 4; ++seed) {
     FiberTextureParams fp;

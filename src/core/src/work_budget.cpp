@@ -1,17 +1,24 @@
 #include "crumple/core/work_budget.hpp"
 
+#include <time.h>
+
 #include <algorithm>
 #include <atomic>
-#include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 
 namespace crumple {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+// The process's CPU time in nanoseconds.
+std::int64_t cpuNanoseconds() {
+  timespec t{};
+  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<std::int64_t>(t.tv_sec) * 1000000000 + t.tv_nsec;
+}
 
-// The deadline in Clock ticks since its epoch; 0 when unarmed.
+// The deadline in CPU nanoseconds; 0 when unarmed.
 std::atomic<std::int64_t> deadline{0};
 std::atomic<double> budgetSeconds{0.0};
 
@@ -26,11 +33,12 @@ std::string budgetText(double seconds) {
 WorkBudgetExceeded::WorkBudgetExceeded(const std::string& stage, double seconds)
     : NumericalError(stage, budgetText(seconds)), seconds_(seconds) {}
 
+double processCpuSeconds() { return static_cast<double>(cpuNanoseconds()) * 1e-9; }
+
 void armWorkBudget(double seconds) {
-  const auto span =
-      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+  const double span = std::min(seconds * 1e9, 1e17);  // within the clock's range
   budgetSeconds.store(seconds, std::memory_order_relaxed);
-  deadline.store(std::max<std::int64_t>(1, (Clock::now() + span).time_since_epoch().count()),
+  deadline.store(std::max<std::int64_t>(1, cpuNanoseconds() + static_cast<std::int64_t>(span)),
                  std::memory_order_relaxed);
 }
 
@@ -38,7 +46,7 @@ void disarmWorkBudget() { deadline.store(0, std::memory_order_relaxed); }
 
 void checkWorkBudget(const char* stage) {
   const std::int64_t at = deadline.load(std::memory_order_relaxed);
-  if (at == 0 || Clock::now().time_since_epoch().count() < at) return;
+  if (at == 0 || cpuNanoseconds() < at) return;
   throw WorkBudgetExceeded(stage, budgetSeconds.load(std::memory_order_relaxed));
 }
 

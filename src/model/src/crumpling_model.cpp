@@ -277,15 +277,15 @@ void CrumplingModel::handOver(TearCut& cut, TearOutcome& out) {
   }
   // This frame's advances as the fine mesh took them (the earlier ones are
   // recorded already).
-  out.events.assign(replayed.events.end() -
-                        std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(r.events.size()),
-                                                 std::ssize(replayed.events)),
-                    replayed.events.end());
+  out.events.assign(
+      replayed.events.end() - std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(r.events.size()),
+                                                       std::ssize(replayed.events)),
+      replayed.events.end());
   const std::vector<Vec3> velocities =
       tear::blendValues(resampled->velocities, replayed.blends, replayed.relocated);
   rig_->rebind(resampled->mesh, resampled->handleVertices, cut.t);
-  auto next = std::make_unique<ElasticModel>(std::move(resampled->mesh), context_, *rig_,
-                                             singularAtStart_);
+  auto next =
+      std::make_unique<ElasticModel>(std::move(resampled->mesh), context_, *rig_, singularAtStart_);
   // Interpolating S_P's long thin cells does not keep the fine mesh's edge
   // lengths: it settles first, with its pins where they are, in a few tiny
   // implicit steps, then takes S_P's velocities.

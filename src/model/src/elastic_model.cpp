@@ -29,10 +29,8 @@ void ElasticModel::attach() {
   sheet_.setContacts(context_->contacts);
   // Fingers that hold patches ([[handles]] patch_radius) grip as firmly as
   // the sheet itself.
-  sheet_.setGrips([&rig = rig_, k = sheet_.inPlaneStiffness()](double t,
-                                                               std::vector<sim::Grip>& out) {
-    rig.grips(t, k, out);
-  });
+  sheet_.setGrips([&rig = rig_, k = sheet_.inPlaneStiffness()](
+                      double t, std::vector<sim::Grip>& out) { rig.grips(t, k, out); });
 }
 
 FrameStats ElasticModel::advance(int frame, const sim::PinFunction& pins) {
@@ -73,7 +71,8 @@ TearOutcome ElasticModel::cut(TearCut& cut) {
   const tear::TearFrameResult& r = cut.result;
   TearOutcome out;
   out.events = r.events;
-  const std::vector<Vec3> velocities = tear::blendValues(sheet_.velocities(), r.blends, r.relocated);
+  const std::vector<Vec3> velocities =
+      tear::blendValues(sheet_.velocities(), r.blends, r.relocated);
   std::map<std::pair<int, int>, std::pair<double, double>> hingeState;
   for (std::size_t h = 0; h < sheet_.hinges().size(); ++h)
     hingeState[{sheet_.hinges()[h].v[0], sheet_.hinges()[h].v[1]}] = {

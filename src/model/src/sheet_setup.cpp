@@ -166,8 +166,8 @@ ShotSheet setUpSheet(const io::SceneSpec& scene, const io::AnimationScene* anima
   out.context = std::make_shared<const ModelContext>(std::move(context));
   if (scene.model.type == io::ModelSpec::Type::Hybrid) {
     auto sheet = std::make_unique<paper::HybridSheet>(
-        crumplingStartSheet(scene, animation, t0).mesh, out.context->material,
-        out.context->sim, crumpleParamsOf(scene.model.hybrid), out.context->seed);
+        crumplingStartSheet(scene, animation, t0).mesh, out.context->material, out.context->sim,
+        crumpleParamsOf(scene.model.hybrid), out.context->seed);
     out.rig = std::make_unique<HandleRig>(scene, animation, sheet->physical().mesh, t0);
     auto crumpling = std::make_unique<CrumplingModel>(std::move(sheet), out.context);
     crumpling->bind(*out.rig, t0);

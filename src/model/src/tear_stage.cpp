@@ -27,8 +27,7 @@ void traceTests(int frame, const mesh::SheetMesh& sheet, const tear::TearFrameRe
                  "%.3f, direction [%.3f, %.3f]%s\n",
                  frame, t.candidate.vertex, tear::candidateKindName(t.candidate.kind), at.x(),
                  at.y(), t.propagation.energyRelease, t.fractureEnergy, t.propagation.angle,
-                 t.propagation.direction.x(), t.propagation.direction.y(),
-                 t.tears ? " tears" : "");
+                 t.propagation.direction.x(), t.propagation.direction.y(), t.tears ? " tears" : "");
   }
   for (const auto& why : r.skipped)
     std::fprintf(stderr, "tear: frame %d not cut: %s\n", frame, why.c_str());

@@ -100,45 +100,20 @@ void ElasticSheet::Impl::dampProduct(const std::vector<Vec3>& u, double dampScal
   scatterProducts(hingeVertices, hingeDamp, u, freeIndex, dampScale, out);
 }
 
-// The tangential displacement over the step u = T (x - x_n) costs
-// mu lambda f0(|u|), where f0 is |u| beyond eps and a cubic below it (static
-// friction as a stiff, capped spring).
-double ElasticSheet::Impl::frictionTerms(const ContactPlane& cp, const Vec3& xi, const Vec3& xni,
-                                         double eps, Vec3* grad, Mat3* hess) {
-  if (!(cp.mu > 0.0) || !(cp.lambda > 0.0)) return 0.0;
-  const Mat3 t = Mat3::Identity() - cp.normal * cp.normal.transpose();
-  const Vec3 u = t * ((xi - xni) - cp.motion);
-  const double y = u.norm();
-  const double scale = cp.mu * cp.lambda;
-  const double f0 = y >= eps ? y : -y * y * y / (3.0 * eps * eps) + y * y / eps + eps / 3.0;
-  if (grad != nullptr) {
-    const double f1OverY = y >= eps ? 1.0 / y : -y / (eps * eps) + 2.0 / eps;
-    const double f1Prime = y >= eps ? 0.0 : -2.0 * y / (eps * eps) + 2.0 / eps;
-    *grad = scale * f1OverY * u;
-    if (hess != nullptr) {
-      Mat3 inner = f1OverY * Mat3::Identity();
-      if (y > 1e-300) {
-        const Vec3 d = u / y;
-        inner += (f1Prime - f1OverY) * d * d.transpose();
-      }
-      *hess = scale * t * inner * t;
-    }
-  }
-  return scale * f0;
-}
-
 double ElasticSheet::Impl::contactEnergy(const std::vector<Vec3>& xs, double eps) const {
   double e = 0.0;
   for (const auto& cp : contactPlanes) {
     const auto vi = static_cast<std::size_t>(cp.vertex);
-    const double gap = cp.gap(xs[vi], contact.distance, nullptr);
-    if (gap > 0.0) e += 0.5 * cp.k * gap * gap;
-    e += frictionTerms(cp, xs[vi], x[vi], eps, nullptr, nullptr);
+    if (double penalty = 0.0; cp.penalty(xs[vi], contact.distance, penalty, nullptr, nullptr))
+      e += penalty;
+    e += cp.friction(xs[vi], x[vi], eps, nullptr, nullptr);
   }
   for (const auto& fc : faceContacts) {
-    const double gap =
-        fc.gap(xs, triangles[static_cast<std::size_t>(fc.triangle)], contact.distance);
-    if (gap > 0.0) e += 0.5 * fc.k * gap * gap;
+    const auto& tri = triangles[static_cast<std::size_t>(fc.triangle)];
+    if (double penalty = 0.0; fc.penalty(
+            xs[static_cast<std::size_t>(tri[0])], xs[static_cast<std::size_t>(tri[1])],
+            xs[static_cast<std::size_t>(tri[2])], contact.distance, penalty, nullptr, nullptr))
+      e += penalty;
   }
   return e;
 }
@@ -165,20 +140,23 @@ bool ElasticSheet::Impl::newtonGradient(NewtonState& s, std::string& why) {
   scatterVectors(hingeVertices, hingeGrad, freeIndex, 1.0, s.gradV);
   for (const auto& cp : contactPlanes) {
     const auto vi = static_cast<std::size_t>(cp.vertex);
-    Vec3 dir;
-    const double gap = cp.gap(xk[vi], contact.distance, &dir);
-    if (gap > 0.0) s.gradV.segment<3>(3 * freeIndex[vi]) -= cp.k * gap * dir;
+    double penalty = 0.0;
+    if (Vec3 g; cp.penalty(xk[vi], contact.distance, penalty, &g, nullptr))
+      s.gradV.segment<3>(3 * freeIndex[vi]) += g;
     Vec3 g = Vec3::Zero();
-    frictionTerms(cp, xk[vi], x[vi], s.frictionEps, &g, nullptr);
+    cp.friction(xk[vi], x[vi], s.frictionEps, &g, nullptr);
     s.gradV.segment<3>(3 * freeIndex[vi]) += g;
   }
   for (const auto& fc : faceContacts) {
     const auto& tri = triangles[static_cast<std::size_t>(fc.triangle)];
-    const double gap = fc.gap(xk, tri, contact.distance);
-    if (!(gap > 0.0)) continue;
+    double penalty = 0.0;
+    Vec9 g;
+    if (!fc.penalty(xk[static_cast<std::size_t>(tri[0])], xk[static_cast<std::size_t>(tri[1])],
+                    xk[static_cast<std::size_t>(tri[2])], contact.distance, penalty, &g, nullptr))
+      continue;
     for (std::size_t a = 0; a < 3; ++a) {
       const int fi = freeIndex[static_cast<std::size_t>(tri[a])];
-      if (fi >= 0) s.gradV.segment<3>(3 * fi) -= fc.k * gap * fc.w[a] * fc.normal;
+      if (fi >= 0) s.gradV.segment<3>(3 * fi) += g.segment<3>(3 * static_cast<int>(a));
     }
   }
   for (const Grip& grip : gripBuffer) {
@@ -218,13 +196,12 @@ bool ElasticSheet::Impl::assembleSystem(const NewtonState& s) {
   for (const auto& cp : contactPlanes) {
     const auto vi = static_cast<std::size_t>(cp.vertex);
     Mat3 block = Mat3::Zero();
-    // Gauss-Newton for a triangle's distance: the curvature term of
-    // |x - q| is left out (it would make the block indefinite).
-    Vec3 dir;
-    if (cp.gap(xk[vi], contact.distance, &dir) > 0.0) block += cp.k * dir * dir.transpose();
+    // Gauss-Newton for a triangle's distance (VertexContact::penalty).
+    double penalty = 0.0;
+    if (Mat3 hp; cp.penalty(xk[vi], contact.distance, penalty, nullptr, &hp)) block += hp;
     Vec3 g;
     Mat3 hf = Mat3::Zero();
-    frictionTerms(cp, xk[vi], x[vi], s.frictionEps, &g, &hf);
+    cp.friction(xk[vi], x[vi], s.frictionEps, &g, &hf);
     block += hf;
     const int* off = vertexOffset.data() + 9 * freeIndex[vi];
     for (int col = 0; col < 3; ++col)
@@ -232,10 +209,12 @@ bool ElasticSheet::Impl::assembleSystem(const NewtonState& s) {
   }
   for (const auto& fc : faceContacts) {
     const auto& tri = triangles[static_cast<std::size_t>(fc.triangle)];
-    if (!(fc.gap(xk, tri, contact.distance) > 0.0)) continue;
-    Vec9 g;
-    for (int a = 0; a < 3; ++a) g.segment<3>(3 * a) = fc.w[static_cast<std::size_t>(a)] * fc.normal;
-    const Mat9 block = fc.k * g * g.transpose();
+    double penalty = 0.0;
+    Mat9 block;
+    if (!fc.penalty(xk[static_cast<std::size_t>(tri[0])], xk[static_cast<std::size_t>(tri[1])],
+                    xk[static_cast<std::size_t>(tri[2])], contact.distance, penalty, nullptr,
+                    &block))
+      continue;
     const int* off = triOffset.data() + 81 * fc.triangle;
     for (int i = 0; i < 81; ++i)
       if (off[i] >= 0) values[off[i]] += block.data()[i];

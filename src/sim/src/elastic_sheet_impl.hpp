@@ -23,6 +23,7 @@
 #include "crumple/core/error.hpp"
 #include "crumple/core/parallel.hpp"
 #include "crumple/sim/colliders.hpp"
+#include "crumple/sim/contact_energies.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
 #include "crumple/sim/energies.hpp"
 #include "crumple/sim/self_contact.hpp"
@@ -185,55 +186,9 @@ struct ElasticSheet::Impl {
   ContactOptions contact;
   std::vector<Vec2> pattern;                        // material coordinates, for self-contact
   std::optional<SelfContactDetector> selfDetector;  // built on first use
-  // Per step: the frozen contact planes (a vertex may have several).
-  struct ContactPlane {
-    int vertex;
-    int collider;   // ColliderSet index, -1 = the sheet itself
-    Vec3 point;     // on the touched surface, where it is at the end of the step
-    Vec3 normal;    // unit, out of the touched surface
-    Vec3 motion;    // the touched surface's displacement over the step
-    double mu;      // Coulomb friction coefficient
-    double lambda;  // lagged normal force (N) at the start of the step
-    double k;       // penalty stiffness (N/m)
-    // An edge or corner contact with another layer (SelfContactPair::face
-    // false) keeps the distance to that triangle, frozen where the layer's
-    // velocity carries it, rather than to a plane: a plane through an edge
-    // would stand in the way of vertices that pass the triangle by.
-    bool toTriangle = false;
-    std::array<Vec3, 3> triangle{};
-    // The penalty's gap (contact distance minus the distance) at x, and the
-    // direction it pushes along.
-    double gap(const Vec3& x, double distance, Vec3* direction) const {
-      if (!toTriangle) {
-        if (direction != nullptr) *direction = normal;
-        return distance - normal.dot(x - point);
-      }
-      const Vec3 d = x - closestPointOnTriangle(x, triangle[0], triangle[1], triangle[2]);
-      const double len = d.norm();
-      if (direction != nullptr) *direction = len > 0.0 ? Vec3(d / len) : normal;
-      return distance - len;
-    }
-  };
+  // Per step: the frozen contacts (a vertex may have several; contact_energies.hpp).
+  using ContactPlane = VertexContact;
   std::vector<ContactPlane> contactPlanes;
-  // A collider probe (a ball's centre, a box's corner) near the inside of a
-  // triangle: the triangle's point w keeps radius + D from it along the
-  // normal frozen at the start of the step (vertex contacts alone let a
-  // ball through a coarse mesh). The penalty acts on the triangle's
-  // vertices through w, in the triangle's own block.
-  struct FaceContact {
-    int triangle;
-    int collider;
-    std::array<double, 3> w;
-    Vec3 probe;  // where the probe ends the step
-    double radius;
-    Vec3 normal;  // unit, from the probe toward the sheet
-    double k;
-    double gap(const std::vector<Vec3>& xs, const std::array<int, 3>& t, double distance) const {
-      Vec3 q = Vec3::Zero();
-      for (std::size_t a = 0; a < 3; ++a) q += w[a] * xs[static_cast<std::size_t>(t[a])];
-      return radius + distance - normal.dot(q - probe);
-    }
-  };
   std::vector<FaceContact> faceContacts;
   std::vector<SelfContactPair> selfPairs;  // this step's, for the failsafe
   std::vector<ContactSample> lastContacts;
@@ -291,11 +246,6 @@ struct ElasticSheet::Impl {
   void startNewton(NewtonState& s);
   // out += beta/h K^_n u (Rayleigh damping with the stiffness frozen at x_n).
   void dampProduct(const std::vector<Vec3>& u, double dampScale, VecX& out) const;
-  // Coulomb friction with the lagged normal force (IPC's smoothed friction
-  // potential, Li et al. 2020, Sec. 5): energy, and gradient and PSD
-  // Hessian block of one contact when asked.
-  static double frictionTerms(const ContactPlane& cp, const Vec3& xi, const Vec3& xni, double eps,
-                              Vec3* grad, Mat3* hess);
   // Penalty and friction energy of the contacts at xs.
   double contactEnergy(const std::vector<Vec3>& xs, double eps) const;
   // The incremental potential's gradient at s.xk over the free DOFs (the

@@ -1,6 +1,6 @@
 #pragma once
 // glTF 2.0 exports of cached frames through assimp's exporter (format
-// "glb2"; issue 8): one binary .glb per frame, and one for the whole shot in
+// "glb2"): one binary .glb per frame, and one for the whole shot in
 // which every frame's mesh is a node whose visibility is keyed. glTF has no
 // visibility, so a frame's node has its scale keyed 1 at its frame and 0
 // elsewhere, with STEP interpolation, keys in seconds at frame / fps. Meshes

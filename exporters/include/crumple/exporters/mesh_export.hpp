@@ -1,5 +1,5 @@
 #pragma once
-// Mesh exports of cached frames (issue 8, `crumple export`): OBJ sequences
+// Mesh exports of cached frames (`crumple export`): OBJ sequences
 // with their .mtl and the pattern-space tear texture, binary PLY sequences,
 // and one USDA file with a time-varying Mesh. Every writer takes one frame
 // as an ExportMesh (positions, triangles, regions, the pattern as UVs), so

@@ -1,5 +1,5 @@
 #pragma once
-// The .pcache mesh cache (DESIGN.md "Cache format"): little-endian, chunked,
+// The .pcache mesh cache (docs/ARCHITECTURE.md "Cache format"): little-endian, chunked,
 // versioned. A header chunk, one chunk per frame (topology only when it
 // changed), each with a CRC32, and a footer with the frame offset table. A
 // reader that finds no footer (a crashed writer) recovers every complete
@@ -67,7 +67,7 @@ struct FrameRecord {
   std::vector<int> singularVertices;
   std::vector<int> junctionVertices;
   std::vector<std::array<int, 2>> rulings;
-  std::uint32_t tearCount = 0;  // tears started so far (issue 6)
+  std::uint32_t tearCount = 0;  // tears started so far
   // Handles, in header.handleNames order: the constrained vertex and the
   // imported track's position at this frame's time.
   std::vector<int> handleVertices;
@@ -108,7 +108,7 @@ class CacheWriter {
   // nothing; append() after close() throws std::logic_error.
   void close();
 
-  // Resume (issue 8, checkpoint and resume): reopens the cache at `path` that
+  // Resume (checkpoint and resume): reopens the cache at `path` that
   // an interrupted (or finished) run wrote with `header`, keeps its first
   // `keepFrames` complete frames and cuts everything after them (frames
   // written after the checkpoint, a torn last chunk, the footer), so that

@@ -1,5 +1,5 @@
 #pragma once
-// What the sheet touches (issue 5), as .pcache extension sub-blocks: the
+// What the sheet touches, as .pcache extension sub-blocks: the
 // header block COLL names the colliders, the frame block CONT lists the
 // contacts at the end of the frame's last step. The pipeline writes them; the
 // sound module reads them. Byte layout in docs/PCACHE.md ("Sub-blocks written

@@ -1,5 +1,5 @@
 #pragma once
-// A shot's sound events (issue 7, item 1; thesis 4.3.2) as .pcache
+// A shot's sound events (thesis 4.3.2) as .pcache
 // extension sub-blocks, so that a soundtrack can be made again without
 // simulating: the header block SNDS says that events were detected and
 // with which parameters, the frame block SEVT lists the frame's crumpling,

@@ -1,5 +1,5 @@
 #pragma once
-// A frame's baked tear textures (issue 6; thesis 3.3.4) as a .pcache frame
+// A frame's baked tear textures (thesis 3.3.4) as a .pcache frame
 // extension sub-block, TEAR: the patches drawn instead of the triangles that
 // border a tear, and their masks packed into one atlas (mesh::TearAtlas,
 // made by tear::bakeTearAtlas). The pipeline writes it; the renderers read

@@ -1,5 +1,5 @@
 #pragma once
-// A shot's contacts (issue 5): the scene's [[colliders]] as a collider set
+// A shot's contacts: the scene's [[colliders]] as a collider set
 // that follows the animation, the contact options of the sheet models, and
 // the depth measure the acceptance asks for at every frame.
 #include <vector>

@@ -1,5 +1,5 @@
 #pragma once
-// `crumple export CACHE --format obj|ply|gltf|usda` (issue 8): the cached
+// `crumple export CACHE --format obj|ply|gltf|usda`: the cached
 // frames as files that DCC tools open, made from the cache alone, so a farm
 // can export any frame range in parallel and retry it. docs/EXPORT.md.
 #include <cstdio>

@@ -1,5 +1,5 @@
 #pragma once
-// Farm execution on Slurm (issue 8, docs/FARM.md; `crumple farm slurm`): one
+// Farm execution on Slurm (docs/FARM.md; `crumple farm slurm`): one
 // simulate job, a render job array over frame chunks that waits for it
 // (afterok), and a finalize job (the soundtrack, the movie) after the whole
 // array. slurmScripts writes the sbatch scripts' text and nothing else;

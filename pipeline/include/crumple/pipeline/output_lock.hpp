@@ -1,5 +1,5 @@
 #pragma once
-// One writer per output folder (DESIGN.md "Invariants everyone keeps"): a
+// One writer per output folder (docs/ARCHITECTURE.md "Invariants everyone keeps"): a
 // command that writes into a folder holds an flock(2) on DIR/.crumple.lock
 // for as long as it writes, so a second crumple writing there at the same
 // time stops with a clear error instead of mixing two shots' files.

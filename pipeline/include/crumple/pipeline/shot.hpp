@@ -1,5 +1,5 @@
 #pragma once
-// One shot, end to end (DESIGN.md "One shot, end to end"): scene + handle
+// One shot, end to end (docs/ARCHITECTURE.md "One shot, end to end"): scene + handle
 // tracks -> elastic sheet, frame by frame -> .pcache; and cache -> frames.
 #include <array>
 #include <cstdint>
@@ -55,7 +55,7 @@ struct ShotOptions {
   RenderSettings rendering;
   std::FILE* log = stderr;  // progress and notes; nullptr: a quiet run
   int interactive = -1;     // -1: detect a terminal on `log`
-  // Checkpoint and resume (issue 8): every this many frames (0: never) the
+  // Checkpoint and resume: every this many frames (0: never) the
   // whole simulation state goes to DIR/checkpoint.bin, atomically; `resume`
   // goes on from it, and the cache ends byte-identical to an uninterrupted
   // run's (docs/CHECKPOINT.md).
@@ -120,7 +120,7 @@ struct ShotReport {
     double most = 0.0;
   };
   std::map<std::size_t, BeyondReach> beyondReach;
-  // Contacts (issue 5): collider and self-contact work (detection, the
+  // Contacts: collider and self-contact work (detection, the
   // failsafe; within the elastic stage, plus the crumpling model's failsafe
   // after its isometry), the deepest free vertex inside a collider or the
   // sheet at any frame (in thicknesses), and the contacts written to the cache.
@@ -135,7 +135,7 @@ struct ShotReport {
   // The contacts' share of the simulation step (elastic, geometric, cones,
   // rebuild, isometry and contact stages).
   double contactShareOfStep() const;
-  // Tearing (issue 6): whether it ran, each tip advance (frame, tear, where
+  // Tearing: whether it ran, each tip advance (frame, tear, where
   // from, E_r and E_f) and the tears' paths in the pattern at the end.
   bool tearingOn = false;
   struct TearAdvance {
@@ -156,7 +156,7 @@ struct ShotReport {
   int tearHandoverFrame = -1;
   double tearMs = 0.0;      // candidates, Griffith tests, cuts, detail paths, baking (wall time)
   double tearBakeMs = 0.0;  // of which baking the tear textures
-  // Sound (issue 7): whether events were detected, how many of each kind
+  // Sound: whether events were detected, how many of each kind
   // (crumpling, friction, tearing), and the soundtrack `run` wrote.
   bool soundOn = false;
   std::array<long, 3> soundEvents{};

@@ -1,5 +1,5 @@
 #pragma once
-// A shot's soundtrack from its cache (issue 7; `crumple sound`, and the end
+// A shot's soundtrack from its cache (`crumple sound`, and the end
 // of `crumple run` for a scene with [sound]): the events the simulation
 // stored (SNDS / SEVT blocks) synthesised with the sound database, heard
 // from the camera (or the scene's listener) over the scene's table, written

@@ -1,5 +1,5 @@
 #pragma once
-// Error types and the exit-status contract of the CLI (DESIGN.md "The command
+// Error types and the exit-status contract of the CLI (docs/ARCHITECTURE.md "The command
 // line"): InputError -> exit 2 (bad input), everything else -> exit 1.
 #include <stdexcept>
 #include <string>

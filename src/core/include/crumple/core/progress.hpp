@@ -1,5 +1,5 @@
 #pragma once
-// Progress on long work (DESIGN.md "The command line"): a redrawn bar with ETA
+// Progress on long work (docs/ARCHITECTURE.md "The command line"): a redrawn bar with ETA
 // on a terminal, one machine-readable "PROGRESS <percent>" line per step
 // otherwise (farm managers parse these).
 #include <chrono>

@@ -1,7 +1,7 @@
 #pragma once
-// Counter-based deterministic RNG (DESIGN.md "Invariants"): every random number
-// is a pure function of (seed, frame, purpose, index), so results never depend
-// on thread scheduling or on the order in which consumers draw.
+// Counter-based deterministic RNG (docs/ARCHITECTURE.md "Invariants everyone keeps"): every random
+// number is a pure function of (seed, frame, purpose, index), so results never depend on thread
+// scheduling or on the order in which consumers draw.
 #include <cstdint>
 
 namespace crumple {

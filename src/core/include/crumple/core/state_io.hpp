@@ -1,5 +1,5 @@
 #pragma once
-// A simulation's state in bytes (issue 8, checkpoint and resume): every
+// A simulation's state in bytes (checkpoint and resume): every
 // stateful stage writes what it carries from one frame to the next, and
 // reads it back into a fresh object, so that a resumed run goes on exactly
 // as the uninterrupted one. Little-endian, IEEE doubles bit for bit; each

@@ -1,12 +1,15 @@
 #pragma once
-// A wall-clock budget for one unit of work (the shot's cost guard: one
+// A budget of CPU time for one unit of work (the shot's cost guard: one
 // frame), checked by the long loops inside the stages (the elastic model's
 // Newton iterations, the crumpling model's length projections). The shot arms
 // it before a frame and disarms it after; a loop that finds the deadline
 // passed throws WorkBudgetExceeded, a NumericalError naming its stage, which
 // unwinds the stage as any numerical failure does (positions restored, the
 // cache kept valid up to the last good frame). Unarmed, a check is one
-// relaxed atomic load. Process-wide: one shot runs per process.
+// relaxed atomic load. Process-wide: one shot runs per process. The clock is
+// the process's CPU time (every thread's), not the wall clock: a machine
+// loaded by other work slows a frame's wall time several times over without
+// its costing more, and must not stop a shot.
 #include <string>
 
 #include "crumple/core/error.hpp"
@@ -22,8 +25,11 @@ class WorkBudgetExceeded : public NumericalError {
   double seconds_;
 };
 
-// Arms the budget: work checked from now on may run `seconds` (> 0) of wall
-// clock. Re-arming replaces the deadline.
+// The process's CPU time so far (s): the clock of the budget.
+double processCpuSeconds();
+
+// Arms the budget: work checked from now on may use `seconds` (> 0) of CPU
+// time. Re-arming replaces the deadline.
 void armWorkBudget(double seconds);
 // No deadline (the default).
 void disarmWorkBudget();

@@ -1,8 +1,8 @@
 #pragma once
 // The sheet as a triangle mesh: every vertex has its 2D pattern (rest) position
-// and its 3D position, every triangle its region (DESIGN.md "Invariants").
-// For the elastic foundation the whole sheet is one region; the hybrid model
-// (paper Sec. 3) assigns flat and curved regions later.
+// and its 3D position, every triangle its region (docs/ARCHITECTURE.md "Invariants everyone
+// keeps"). For the elastic foundation the whole sheet is one region; the hybrid model (paper Sec.
+// 3) assigns flat and curved regions later.
 #include <array>
 #include <cstdint>
 #include <string>
@@ -41,7 +41,7 @@ struct MeshEdge {
 // non-manifold edge (three or more triangles).
 std::vector<MeshEdge> buildEdges(const SheetMesh& mesh);
 
-// Checkpoint and resume (issue 8): the whole mesh (pattern, positions,
+// Checkpoint and resume: the whole mesh (pattern, positions,
 // triangles, regions) in a state; restoreSheetMesh throws CorruptDataError
 // for indices out of range or sizes that do not match.
 void saveSheetMesh(StateWriter& out, const SheetMesh& mesh);

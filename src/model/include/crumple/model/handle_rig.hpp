@@ -61,7 +61,7 @@ class HandleRig {
   // pin comes first, its tangent-plane pins right after it (the crumpling
   // model moves them with a handle that lags, paper::HybridSheet).
   void pins(double t, std::vector<sim::Pin>& out) const;
-  // The sheet's reach (issue 9, stability): a rectangular sheet that cannot
+  // The sheet's reach (stability): a rectangular sheet that cannot
   // tear cannot hold two handles farther apart than their pattern points
   // (times 1 + kReachSlack). Where the nodes ask for more, the handle whose
   // node has moved farther from its first-frame position stops on that
@@ -91,7 +91,7 @@ class HandleRig {
   void rebindPatches(const mesh::SheetMesh& sheet, double t);
   // Moves pinned vertices onto their targets (called once before simulation).
   void snap(double t, std::vector<Vec3>& positions) const;
-  // Checkpoint and resume (issue 8): each handle's vertex, tangent-plane
+  // Checkpoint and resume: each handle's vertex, tangent-plane
   // vertices and offsets and bind rotation, for a rig bound again from the
   // same scene. restoreState throws CorruptDataError for another rig's.
   void saveState(StateWriter& out) const;

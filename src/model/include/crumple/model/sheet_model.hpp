@@ -90,13 +90,13 @@ struct TearCut {
   int frame = 0;
   double t = 0.0;  // the frame's time (s)
   const tear::TearFrameResult& result;
-  mesh::SheetMesh& sheet;                      // the mesh the tear stage cut
-  tear::Tearing& tearing;                      // the tears so far
+  mesh::SheetMesh& sheet;                       // the mesh the tear stage cut
+  tear::Tearing& tearing;                       // the tears so far
   const std::vector<tear::TearEvent>& earlier;  // every advance of earlier frames
 };
 struct TearOutcome {
-  std::vector<tear::TearEvent> events;  // the frame's advances as the model took them
-  std::unique_ptr<class SheetModel> replacement;  // a hand-over: the model from now on
+  std::vector<tear::TearEvent> events;              // the frame's advances as the model took them
+  std::unique_ptr<class SheetModel> replacement;    // a hand-over: the model from now on
   std::optional<tear::Tearing> replacementTearing;  // and its tears
   std::vector<std::string> notes;
   int geometricCuts = 0;     // advances cut in the crumpling model's S_G

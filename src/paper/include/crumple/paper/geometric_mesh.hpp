@@ -109,7 +109,7 @@ std::vector<int> compact(GeometricMesh& g);
 // and another region meet. Sorted.
 std::vector<int> junctionVertices(const GeometricMesh& g);
 
-// Region invariants (issue 3, "in debug builds"): indices in range, faces
+// Region invariants ("in debug builds"): indices in range, faces
 // counter-clockwise and non-degenerate in the pattern, the faces cover the
 // outline exactly (area sum equal within 1e-9 relative), boundary vertices
 // on their outline segment, curved-region faces consistent with their

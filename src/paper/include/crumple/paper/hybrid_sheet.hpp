@@ -29,7 +29,7 @@ struct HybridStageTimes {
   double cones = 0.0;      // generalized-cone fitting (paper Sec. 6.2)
   double rebuild = 0.0;    // S_P from S_G, fiber damage, elastic-model setup
   double isometry = 0.0;   // paper Sec. 6.3
-  // The contact failsafe after the isometry (issue 5): against colliders,
+  // The contact failsafe after the isometry: against colliders,
   // and self-contact (with carrying the contact set over to S_P).
   double contacts = 0.0;
   double selfContacts = 0.0;
@@ -115,7 +115,7 @@ class HybridSheet {
   // default (no cost).
   void setProjectionCallback(std::function<void(const ProjectionInput&)> callback);
 
-  // Contacts (issue 5): the elastic step of every animation step takes them
+  // Contacts: the elastic step of every animation step takes them
   // (sim::ElasticSheet::setContacts), and after the isometry projection a
   // failsafe moves free S_P vertices nearer than 0.95 distance to a collider
   // or to another layer of the sheet back out to the distance. Off by
@@ -141,7 +141,7 @@ class HybridSheet {
     Vec2 to = Vec2::Zero();
     std::optional<Vec2> previousDirection;
   };
-  // Tears the sheet (issue 6, thesis 3.3.3 "Remeshing"): S_G takes the
+  // Tears the sheet (thesis 3.3.3 "Remeshing"): S_G takes the
   // current positions and velocities of S_P, each advance cuts it in turn
   // (cutGeometricMesh), and S_P is rebuilt from it; the model goes on
   // crumpling the torn sheet. All or nothing: std::nullopt, the sheet as it
@@ -154,7 +154,7 @@ class HybridSheet {
   // positions and velocities, its hinges' rest angles and stiffness factors
   // (fiber damage), the membrane forces on a vertex (what a tear tip feels,
   // thesis 3.3.3), and the state a torn sheet carries over to a plain
-  // sim::ElasticSheet (issue 6).
+  // sim::ElasticSheet.
   const sim::ElasticSheet& elastic() const;
   const GeometricMesh& geometric() const;  // S_G
   const PhysicalMesh& physical() const;    // S_P (the displayed mesh)
@@ -162,7 +162,7 @@ class HybridSheet {
   int singularVertexCount() const;
   int interiorSingularVertexCount() const;
 
-  // Checkpoint and resume (issue 8): S_G, S_P with its samples, the
+  // Checkpoint and resume: S_G, S_P with its samples, the
   // velocities, the time, the contacts, the remeshing cooldowns and the
   // elastic model's state, written for a sheet built again from the same
   // scene (same material, parameters and seed). restoreState rebuilds the

@@ -1,6 +1,6 @@
 #pragma once
 // Isometry projection of S_P onto its pattern (paper Sec. 6.3, "Preserving
-// length with respect to the pattern", eqs. (3)-(7); DESIGN.md step 3).
+// length with respect to the pattern", eqs. (3)-(7); docs/ARCHITECTURE.md "One shot, end to end").
 //
 // Phase I (eqs. (3)-(6)). One direction u_e per undirected edge, oriented
 // from the lower to the higher vertex index; a triangle's closure sum takes

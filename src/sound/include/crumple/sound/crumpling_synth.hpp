@@ -1,5 +1,5 @@
 #pragma once
-// A crumpling event's sound (thesis 4.3.3; issue 7, item 4): the clip of
+// A crumpling event's sound (thesis 4.3.3): the clip of
 // the database cell nearest its resonator's (l_r, l_c), one of the cell's
 // variants drawn at random, scaled by the event's amplitude, spatialised
 // (eq. 4.11) and placed at the event's exact sample.

@@ -1,5 +1,5 @@
 #pragma once
-// The sound database (thesis 4.3.3; issue 7, item 3): for each resonator
+// The sound database (thesis 4.3.3): for each resonator
 // size (l_r, the mean ruling length, and l_c, the total free curved border
 // length), crumpling clips in the time domain and friction power spectra,
 // several variants per cell, plus the constrained cell (0, 0) that every

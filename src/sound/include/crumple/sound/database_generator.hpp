@@ -1,5 +1,5 @@
 #pragma once
-// The generated default sound database (thesis 4.3.3; issue 7, item 3;
+// The generated default sound database (thesis 4.3.3;
 // docs/SOUND.md "The default database"). There are no recordings to ship,
 // so the database is made from a physically motivated model of what the
 // thesis recorded: for each resonator size (l_r, l_c), a sheet of

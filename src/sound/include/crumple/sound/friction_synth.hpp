@@ -1,5 +1,5 @@
 #pragma once
-// Friction noise from power spectra (thesis 4.3.3; issue 7, item 4): each
+// Friction noise from power spectra (thesis 4.3.3): each
 // block of M/2 samples sounds the power spectrum the friction events of that
 // block ask for (the database's spectra, weighted), as noise of random
 // phases made by an inverse FFT (FFTW c2r) and overlap-added by M/2 with a

@@ -1,6 +1,6 @@
 #pragma once
-// A shot's soundtrack from its events (thesis Algorithm 4 and 4.3.4;
-// issue 7, items 4-5): every crumpling resonator's clip at its frame's
+// A shot's soundtrack from its events (thesis Algorithm 4 and 4.3.4):
+// every crumpling resonator's clip at its frame's
 // sample, the friction resonators' spectra summed per frame and sounded as
 // noise, every tear's crackle following its tip's speed; each source a
 // dipole, with its image in the table, heard from the listener (the

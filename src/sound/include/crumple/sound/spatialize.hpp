@@ -1,5 +1,5 @@
 #pragma once
-// Spatialisation (thesis 4.3.4, eqs. (4.6)-(4.12); issue 7, item 5): each
+// Spatialisation (thesis 4.3.4, eqs. (4.6)-(4.12)): each
 // resonator radiates as a small vibrating disk, a dipole of pressure
 // a^3 cos(theta) / R A(t - R / c); a rigid table adds the image dipole
 // (position and normal mirrored in its plane). Crumpling clips are placed

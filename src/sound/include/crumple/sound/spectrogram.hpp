@@ -1,5 +1,5 @@
 #pragma once
-// The soundtrack's spectrogram (issue 7, item 6: a PNG beside the WAV, as
+// The soundtrack's spectrogram (a PNG beside the WAV, as
 // the thesis shows its results, Figs. 4.4, 4.20-4.22): time left to right,
 // frequency 0 to rate / 2 bottom to top, level in dB as colour.
 #include <cstdint>

@@ -1,5 +1,5 @@
 #pragma once
-// The sound of a tear (thesis 4.4.1; issue 7, item 4): white noise whose
+// The sound of a tear (thesis 4.4.1): white noise whose
 // every sample is multiplied by r^alpha, r uniform in [0, 1) drawn per
 // sample (alpha = 1: white noise; alpha = 100, the thesis' value: a
 // crackle of sparse bursts, the breaking fibres), with its amplitude and

@@ -1,5 +1,5 @@
 #pragma once
-// The soundtrack's file and clock (issue 7, item 6; DESIGN.md "Outputs"):
+// The soundtrack's file and clock (docs/ARCHITECTURE.md "The command line"):
 // sample i sounds at time i / rate after the shot's first frame, and a
 // soundtrack lasts exactly frame_count / fps. WAV files through libsndfile:
 // 24-bit PCM or 32-bit float, 48 kHz by default, 44.1 kHz selectable.
