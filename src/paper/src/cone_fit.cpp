@@ -350,6 +350,228 @@ bool convexFace(const std::array<Vec2, 4>& poly, const std::array<bool, 4>& skip
   }
   return true;
 }
+
+// paper Sec. 6.2, Fig. 15: orients the rulings so that every .a is on the side of r_0.a.
+void orientRulings(const GeometricMesh& g, std::vector<Ruling>& rulings) {
+  for (std::size_t k = 1; k < rulings.size(); ++k) {
+    const Ruling& p = rulings[k - 1];
+    Ruling& r = rulings[k];
+    bool flip = false;
+    if (r.a == p.a || r.b == p.b) {
+      flip = false;
+    } else if (r.a == p.b || r.b == p.a) {
+      flip = true;
+    } else {
+      const auto P = [&](int v) -> const Vec2& {
+        return g.vertices[static_cast<std::size_t>(v)].pattern;
+      };
+      flip = (P(r.b) - P(p.a)).norm() + (P(r.a) - P(p.b)).norm() <
+             (P(r.a) - P(p.a)).norm() + (P(r.b) - P(p.b)).norm();
+    }
+    if (flip) std::swap(r.a, r.b);
+  }
+}
+
+// thesis 2.5.2: marks the vertices the resampling keeps; returns the region's faces by vertex set.
+std::map<std::vector<int>, int> markFixedVertices(const GeometricMesh& g, int region,
+                                                  RegionContext& ctx) {
+  const int nv = static_cast<int>(g.vertices.size());
+  ctx.fixedVertex.assign(static_cast<std::size_t>(nv), 0);
+  for (int v = 0; v < nv; ++v) {
+    const GeometricVertex& gv = g.vertices[static_cast<std::size_t>(v)];
+    ctx.fixedVertex[static_cast<std::size_t>(v)] = gv.handle || gv.singular || gv.corner;
+  }
+  std::map<std::vector<int>, int> faceOf;  // sorted vertex set -> face of this region
+  for (std::size_t f = 0; f < g.faces.size(); ++f) {
+    const GeometricFace& face = g.faces[f];
+    if (face.region != region) {
+      for (int k = 0; k < face.size(); ++k)
+        ctx.fixedVertex[static_cast<std::size_t>(face.v[k])] = 1;
+      continue;
+    }
+    std::vector<int> key(face.v.begin(), face.v.begin() + face.size());
+    std::sort(key.begin(), key.end());
+    faceOf[key] = static_cast<int>(f);
+  }
+  return faceOf;
+}
+
+// paper Sec. 6.2: each ruling's tangent-plane normal; false when one has no tangent plane.
+bool setRulingNormals(const GeometricMesh& g, const std::map<std::vector<int>, int>& faceOf,
+                      RegionContext& ctx) {
+  const std::size_t nr = ctx.rulings.size();
+  std::vector<Vec3> faceNormals(nr - 1);
+  for (std::size_t k = 0; k + 1 < nr; ++k) {
+    const Ruling& r0 = ctx.rulings[k];
+    const Ruling& r1 = ctx.rulings[k + 1];
+    std::vector<int> key{r0.a, r0.b, r1.a, r1.b};
+    std::sort(key.begin(), key.end());
+    key.erase(std::unique(key.begin(), key.end()), key.end());
+    const auto it = faceOf.find(key);
+    faceNormals[k] = it != faceOf.end() ? faceNormal(g, it->second) : polygonNormal(g, r0, r1);
+  }
+  ctx.rulingNormal.resize(nr);
+  for (std::size_t k = 0; k < nr; ++k) {
+    Vec3 n = Vec3::Zero();
+    if (k > 0) n += faceNormals[k - 1];
+    if (k + 1 < nr) n += faceNormals[k];
+    if (!n.allFinite())
+      throw NumericalError(kStage, "face normal of a curved region is not finite");
+    if (!(n.norm() > 1e-12)) return false;
+    ctx.rulingNormal[k] = n.normalized();
+  }
+  return true;
+}
+
+// paper Sec. 6.2, Fig. 15: the runs of consecutive rulings between two boundary chains on dS.
+std::vector<std::pair<int, int>> boundaryRuns(const GeometricMesh& g,
+                                              const std::vector<Ruling>& rulings) {
+  const std::size_t nr = rulings.size();
+  std::set<std::pair<int, int>> boundaryEdges;
+  for (const GeometricEdge& e : buildEdges(g)) {
+    if (!e.interior()) boundaryEdges.insert({e.v[0], e.v[1]});
+  }
+  const auto onBoundary = [&](int v) {
+    const GeometricVertex& gv = g.vertices[static_cast<std::size_t>(v)];
+    return gv.onBoundary && gv.outlineSegment >= 0 &&
+           gv.outlineSegment < static_cast<int>(g.outline.size());
+  };
+  const auto sideOnBoundary = [&](int a, int b) {
+    return a == b || boundaryEdges.contains({std::min(a, b), std::max(a, b)});
+  };
+  std::vector<std::pair<int, int>> runs;
+  for (int k = 0; k < static_cast<int>(nr);) {
+    const Ruling& r = rulings[static_cast<std::size_t>(k)];
+    if (!onBoundary(r.a) || !onBoundary(r.b)) {
+      ++k;
+      continue;
+    }
+    int e = k;
+    while (e + 1 < static_cast<int>(nr)) {
+      const Ruling& p = rulings[static_cast<std::size_t>(e)];
+      const Ruling& q = rulings[static_cast<std::size_t>(e + 1)];
+      if (!onBoundary(q.a) || !onBoundary(q.b) || !sideOnBoundary(p.a, q.a) ||
+          !sideOnBoundary(p.b, q.b))
+        break;
+      ++e;
+    }
+    if (e > k) runs.emplace_back(k, e);
+    k = e + 1;
+  }
+  return runs;
+}
+
+// thesis 2.5.2, Fig. 2.19: one refitted run's rulings, its new endpoints added on dS.
+std::vector<Ruling> runRulings(GeometricMesh& g, const BoundaryCurve& curve,
+                               const RegionContext& ctx, const std::pair<int, int>& run,
+                               const RunResult& rr) {
+  // Velocities of the old chain vertices, to interpolate along each chain.
+  std::array<std::vector<std::pair<double, Vec3>>, 2> velocity;
+  for (int k = run.first; k <= run.second; ++k) {
+    const Ruling& r = ctx.rulings[static_cast<std::size_t>(k)];
+    for (std::size_t c = 0; c < 2; ++c) {
+      const int v = c == 0 ? r.a : r.b;
+      velocity[c].emplace_back(rr.chains[c].tOf(vertexS(g, v)),
+                               g.vertices[static_cast<std::size_t>(v)].velocity);
+    }
+  }
+  std::array<std::map<double, int>, 2> created;
+  const double same = 1e-9 * ctx.spacing;
+  const auto vertexAt = [&](std::size_t c, double t) {
+    auto it = created[c].lower_bound(t - same);
+    if (it != created[c].end() && std::abs(it->first - t) <= same) return it->second;
+    const Chain& chain = rr.chains[c];
+    const double s = chain.sAt(t);
+    GeometricVertex v;
+    int seg = -1;
+    v.pattern = outlinePoint(g, s, &seg);
+    v.position = curve.evaluate(s);
+    v.onBoundary = true;
+    v.outlineSegment = seg;
+    const auto& vel = velocity[c];
+    std::size_t j = 0;
+    while (j + 1 < vel.size() && vel[j + 1].first < t) ++j;
+    if (j + 1 < vel.size() && vel[j + 1].first > vel[j].first) {
+      const double f = std::clamp((t - vel[j].first) / (vel[j + 1].first - vel[j].first), 0.0, 1.0);
+      v.velocity = (1.0 - f) * vel[j].second + f * vel[j + 1].second;
+    } else {
+      v.velocity = vel[j].second;
+    }
+    requireFinite(v.pattern, "new boundary vertex");
+    requireFinite(v.position, "new boundary vertex");
+    const int id = addVertex(g, v);
+    created[c][t] = id;
+    return id;
+  };
+  std::vector<Ruling> out;
+  for (const ChainRuling& cr : rr.rulings) {
+    Ruling r;
+    r.a = cr.v[0] >= 0 ? cr.v[0] : vertexAt(0, cr.t[0]);
+    r.b = cr.v[1] >= 0 ? cr.v[1] : vertexAt(1, cr.t[1]);
+    out.push_back(r);
+  }
+  return out;
+}
+
+// paper Sec. 6.2: the region's new ruling list, each run of `old` replaced by its refit.
+std::vector<Ruling> spliceRuns(const std::vector<Ruling>& old,
+                               const std::vector<std::pair<int, int>>& runs,
+                               const std::vector<std::vector<Ruling>>& runRulings) {
+  const std::size_t nr = old.size();
+  std::vector<Ruling> rulings;
+  std::size_t run = 0;
+  for (int k = 0; k < static_cast<int>(nr);) {
+    if (run < runs.size() && runs[run].first == k) {
+      for (const Ruling& r : runRulings[run]) rulings.push_back(r);
+      k = runs[run].second + 1;
+      ++run;
+      continue;
+    }
+    rulings.push_back(old[static_cast<std::size_t>(k)]);
+    ++k;
+  }
+  return rulings;
+}
+
+// Whether every new face is convex in the pattern, oriented as the faces between `old`.
+bool refittedFacesValid(const GeometricMesh& g, const std::vector<Ruling>& old,
+                        const std::vector<Ruling>& rulings) {
+  const std::size_t nr = old.size();
+  const auto P = [&](int v) -> const Vec2& {
+    return g.vertices[static_cast<std::size_t>(v)].pattern;
+  };
+  double sign = 0.0;
+  for (std::size_t k = 0; k + 1 < nr && sign == 0.0; ++k) {
+    const Ruling& r0 = old[k];
+    const Ruling& r1 = old[k + 1];
+    const double area = cross2(P(r0.a), P(r1.a)) + cross2(P(r1.a), P(r1.b)) +
+                        cross2(P(r1.b), P(r0.b)) + cross2(P(r0.b), P(r0.a));
+    if (area != 0.0) sign = area > 0.0 ? 1.0 : -1.0;
+  }
+  const double minArea = 1e-14 * std::abs(outlineArea(g));
+  std::set<std::array<int, 4>> originalFaces;
+  for (std::size_t k = 0; k + 1 < nr; ++k) {
+    const Ruling& r0 = old[k];
+    const Ruling& r1 = old[k + 1];
+    originalFaces.insert({r0.a, r0.b, r1.a, r1.b});
+  }
+  bool ok = sign != 0.0;
+  for (std::size_t k = 0; ok && k + 1 < rulings.size(); ++k) {
+    const Ruling& r0 = rulings[k];
+    const Ruling& r1 = rulings[k + 1];
+    if (originalFaces.contains({r0.a, r0.b, r1.a, r1.b})) continue;  // untouched face
+    const std::array<int, 4> ids{r0.a, r1.a, r1.b, r0.b};
+    std::array<Vec2, 4> poly;
+    std::array<bool, 4> skip{false, false, false, false};
+    for (std::size_t j = 0; j < 4; ++j) poly[j] = P(ids[j]);
+    if (ids[1] == ids[0]) skip[1] = true;
+    if (ids[2] == ids[3]) skip[3] = true;
+    if (r0.a == r1.a && r0.b == r1.b) continue;
+    ok = convexFace(poly, skip, sign, minArea);
+  }
+  return ok;
+}
+
 }  // namespace
 
 // paper Sec. 6.2 (last paragraphs), Fig. 15; thesis 2.5.2, Fig. 2.19.
@@ -393,102 +615,20 @@ ConeRefitResult refitCurvedRegion(GeometricMesh& g, int region, const BoundaryCu
 
   // Orient the rulings: a on the side of r_0.a.
   ctx.rulings = reg.rulings;
-  for (std::size_t k = 1; k < ctx.rulings.size(); ++k) {
-    const Ruling& p = ctx.rulings[k - 1];
-    Ruling& r = ctx.rulings[k];
-    bool flip = false;
-    if (r.a == p.a || r.b == p.b) {
-      flip = false;
-    } else if (r.a == p.b || r.b == p.a) {
-      flip = true;
-    } else {
-      const auto P = [&](int v) -> const Vec2& {
-        return g.vertices[static_cast<std::size_t>(v)].pattern;
-      };
-      flip = (P(r.b) - P(p.a)).norm() + (P(r.a) - P(p.b)).norm() <
-             (P(r.a) - P(p.a)).norm() + (P(r.b) - P(p.b)).norm();
-    }
-    if (flip) std::swap(r.a, r.b);
-  }
+  orientRulings(g, ctx.rulings);
 
   // Vertices that never move: handles, singular vertices, corners and
   // vertices of other regions' faces.
-  ctx.fixedVertex.assign(static_cast<std::size_t>(nv), 0);
-  for (int v = 0; v < nv; ++v) {
-    const GeometricVertex& gv = g.vertices[static_cast<std::size_t>(v)];
-    ctx.fixedVertex[static_cast<std::size_t>(v)] = gv.handle || gv.singular || gv.corner;
-  }
-  std::map<std::vector<int>, int> faceOf;  // sorted vertex set -> face of this region
-  for (std::size_t f = 0; f < g.faces.size(); ++f) {
-    const GeometricFace& face = g.faces[f];
-    if (face.region != region) {
-      for (int k = 0; k < face.size(); ++k)
-        ctx.fixedVertex[static_cast<std::size_t>(face.v[k])] = 1;
-      continue;
-    }
-    std::vector<int> key(face.v.begin(), face.v.begin() + face.size());
-    std::sort(key.begin(), key.end());
-    faceOf[key] = static_cast<int>(f);
-  }
+  const std::map<std::vector<int>, int> faceOf = markFixedVertices(g, region, ctx);
 
   // Tangent plane normals: mean faceNormal of the faces on both sides.
-  const std::size_t nr = ctx.rulings.size();
-  std::vector<Vec3> faceNormals(nr - 1);
-  for (std::size_t k = 0; k + 1 < nr; ++k) {
-    const Ruling& r0 = ctx.rulings[k];
-    const Ruling& r1 = ctx.rulings[k + 1];
-    std::vector<int> key{r0.a, r0.b, r1.a, r1.b};
-    std::sort(key.begin(), key.end());
-    key.erase(std::unique(key.begin(), key.end()), key.end());
-    const auto it = faceOf.find(key);
-    faceNormals[k] = it != faceOf.end() ? faceNormal(g, it->second) : polygonNormal(g, r0, r1);
-  }
-  ctx.rulingNormal.resize(nr);
-  for (std::size_t k = 0; k < nr; ++k) {
-    Vec3 n = Vec3::Zero();
-    if (k > 0) n += faceNormals[k - 1];
-    if (k + 1 < nr) n += faceNormals[k];
-    if (!n.allFinite())
-      throw NumericalError(kStage, "face normal of a curved region is not finite");
-    if (!(n.norm() > 1e-12)) {
-      result.skipped = "a ruling has no tangent plane (degenerate faces)";
-      return result;
-    }
-    ctx.rulingNormal[k] = n.normalized();
+  if (!setRulingNormals(g, faceOf, ctx)) {
+    result.skipped = "a ruling has no tangent plane (degenerate faces)";
+    return result;
   }
 
   // Runs of rulings whose endpoints lie on dS, joined by boundary edges.
-  std::set<std::pair<int, int>> boundaryEdges;
-  for (const GeometricEdge& e : buildEdges(g)) {
-    if (!e.interior()) boundaryEdges.insert({e.v[0], e.v[1]});
-  }
-  const auto onBoundary = [&](int v) {
-    const GeometricVertex& gv = g.vertices[static_cast<std::size_t>(v)];
-    return gv.onBoundary && gv.outlineSegment >= 0 &&
-           gv.outlineSegment < static_cast<int>(g.outline.size());
-  };
-  const auto sideOnBoundary = [&](int a, int b) {
-    return a == b || boundaryEdges.contains({std::min(a, b), std::max(a, b)});
-  };
-  std::vector<std::pair<int, int>> runs;
-  for (int k = 0; k < static_cast<int>(nr);) {
-    const Ruling& r = ctx.rulings[static_cast<std::size_t>(k)];
-    if (!onBoundary(r.a) || !onBoundary(r.b)) {
-      ++k;
-      continue;
-    }
-    int e = k;
-    while (e + 1 < static_cast<int>(nr)) {
-      const Ruling& p = ctx.rulings[static_cast<std::size_t>(e)];
-      const Ruling& q = ctx.rulings[static_cast<std::size_t>(e + 1)];
-      if (!onBoundary(q.a) || !onBoundary(q.b) || !sideOnBoundary(p.a, q.a) ||
-          !sideOnBoundary(p.b, q.b))
-        break;
-      ++e;
-    }
-    if (e > k) runs.emplace_back(k, e);
-    k = e + 1;
-  }
+  const std::vector<std::pair<int, int>> runs = boundaryRuns(g, ctx.rulings);
   if (runs.empty()) {
     result.skipped = "no two consecutive rulings run between boundary chains on dS";
     return result;
@@ -506,103 +646,14 @@ ConeRefitResult refitCurvedRegion(GeometricMesh& g, int region, const BoundaryCu
 
   // Apply: create the new vertices and the new ruling list.
   const std::size_t verticesBefore = g.vertices.size();
-  std::vector<std::vector<Ruling>> runRulings(runs.size());
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    const RunResult& rr = runResults[i];
-    // Velocities of the old chain vertices, to interpolate along each chain.
-    std::array<std::vector<std::pair<double, Vec3>>, 2> velocity;
-    for (int k = runs[i].first; k <= runs[i].second; ++k) {
-      const Ruling& r = ctx.rulings[static_cast<std::size_t>(k)];
-      for (std::size_t c = 0; c < 2; ++c) {
-        const int v = c == 0 ? r.a : r.b;
-        velocity[c].emplace_back(rr.chains[c].tOf(vertexS(g, v)),
-                                 g.vertices[static_cast<std::size_t>(v)].velocity);
-      }
-    }
-    std::array<std::map<double, int>, 2> created;
-    const double same = 1e-9 * ctx.spacing;
-    const auto vertexAt = [&](std::size_t c, double t) {
-      auto it = created[c].lower_bound(t - same);
-      if (it != created[c].end() && std::abs(it->first - t) <= same) return it->second;
-      const Chain& chain = rr.chains[c];
-      const double s = chain.sAt(t);
-      GeometricVertex v;
-      int seg = -1;
-      v.pattern = outlinePoint(g, s, &seg);
-      v.position = curve.evaluate(s);
-      v.onBoundary = true;
-      v.outlineSegment = seg;
-      const auto& vel = velocity[c];
-      std::size_t j = 0;
-      while (j + 1 < vel.size() && vel[j + 1].first < t) ++j;
-      if (j + 1 < vel.size() && vel[j + 1].first > vel[j].first) {
-        const double f =
-            std::clamp((t - vel[j].first) / (vel[j + 1].first - vel[j].first), 0.0, 1.0);
-        v.velocity = (1.0 - f) * vel[j].second + f * vel[j + 1].second;
-      } else {
-        v.velocity = vel[j].second;
-      }
-      requireFinite(v.pattern, "new boundary vertex");
-      requireFinite(v.position, "new boundary vertex");
-      const int id = addVertex(g, v);
-      created[c][t] = id;
-      return id;
-    };
-    for (const ChainRuling& cr : rr.rulings) {
-      Ruling r;
-      r.a = cr.v[0] >= 0 ? cr.v[0] : vertexAt(0, cr.t[0]);
-      r.b = cr.v[1] >= 0 ? cr.v[1] : vertexAt(1, cr.t[1]);
-      runRulings[i].push_back(r);
-    }
-  }
-  std::vector<Ruling> rulings;
-  std::size_t run = 0;
-  for (int k = 0; k < static_cast<int>(nr);) {
-    if (run < runs.size() && runs[run].first == k) {
-      for (const Ruling& r : runRulings[run]) rulings.push_back(r);
-      k = runs[run].second + 1;
-      ++run;
-      continue;
-    }
-    rulings.push_back(ctx.rulings[static_cast<std::size_t>(k)]);
-    ++k;
-  }
+  std::vector<std::vector<Ruling>> newRunRulings(runs.size());
+  for (std::size_t i = 0; i < runs.size(); ++i)
+    newRunRulings[i] = runRulings(g, curve, ctx, runs[i], runResults[i]);
+  std::vector<Ruling> rulings = spliceRuns(ctx.rulings, runs, newRunRulings);
 
   // Check every new face (pattern, strictly convex, same orientation as the
   // region's faces) before committing.
-  const auto P = [&](int v) -> const Vec2& {
-    return g.vertices[static_cast<std::size_t>(v)].pattern;
-  };
-  double sign = 0.0;
-  for (std::size_t k = 0; k + 1 < nr && sign == 0.0; ++k) {
-    const Ruling& r0 = ctx.rulings[k];
-    const Ruling& r1 = ctx.rulings[k + 1];
-    const double area = cross2(P(r0.a), P(r1.a)) + cross2(P(r1.a), P(r1.b)) +
-                        cross2(P(r1.b), P(r0.b)) + cross2(P(r0.b), P(r0.a));
-    if (area != 0.0) sign = area > 0.0 ? 1.0 : -1.0;
-  }
-  const double minArea = 1e-14 * std::abs(outlineArea(g));
-  std::set<std::array<int, 4>> originalFaces;
-  for (std::size_t k = 0; k + 1 < nr; ++k) {
-    const Ruling& r0 = ctx.rulings[k];
-    const Ruling& r1 = ctx.rulings[k + 1];
-    originalFaces.insert({r0.a, r0.b, r1.a, r1.b});
-  }
-  bool ok = sign != 0.0;
-  for (std::size_t k = 0; ok && k + 1 < rulings.size(); ++k) {
-    const Ruling& r0 = rulings[k];
-    const Ruling& r1 = rulings[k + 1];
-    if (originalFaces.contains({r0.a, r0.b, r1.a, r1.b})) continue;  // untouched face
-    const std::array<int, 4> ids{r0.a, r1.a, r1.b, r0.b};
-    std::array<Vec2, 4> poly;
-    std::array<bool, 4> skip{false, false, false, false};
-    for (std::size_t j = 0; j < 4; ++j) poly[j] = P(ids[j]);
-    if (ids[1] == ids[0]) skip[1] = true;
-    if (ids[2] == ids[3]) skip[3] = true;
-    if (r0.a == r1.a && r0.b == r1.b) continue;
-    ok = convexFace(poly, skip, sign, minArea);
-  }
-  if (!ok) {
+  if (!refittedFacesValid(g, ctx.rulings, rulings)) {
     g.vertices.resize(verticesBefore);
     result.skipped = "the refitted faces would be degenerate or non-convex";
     return result;

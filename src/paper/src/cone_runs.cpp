@@ -25,6 +25,43 @@ std::vector<double> uniformInterior(double lo, double hi, double h) {
   return out;
 }
 
+// paper Sec. 6.2 (normals constant along a ruling): the tangent planes and
+// geometry of rulings first..first + n - 1 and the apex fit's frame.
+struct RunPlanes {
+  std::vector<RulingPlane> planes;
+  std::vector<RulingGeometry> geometry;
+  FitFrame frame;
+};
+std::string runPlanes(const RegionContext& ctx, int first, int n, RunPlanes& out) {
+  const GeometricMesh& g = *ctx.g;
+  std::vector<RulingPlane>& planes = out.planes;
+  std::vector<RulingGeometry>& geometry = out.geometry;
+  FitFrame& frame = out.frame;
+  planes.resize(static_cast<std::size_t>(n));
+  geometry.resize(static_cast<std::size_t>(n));
+  frame.centre = Vec3::Zero();
+  double lengthSum = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const Ruling& r = ctx.rulings[static_cast<std::size_t>(first + k)];
+    const GeometricVertex& va = g.vertices[static_cast<std::size_t>(r.a)];
+    const GeometricVertex& vb = g.vertices[static_cast<std::size_t>(r.b)];
+    const Vec3 normal = ctx.rulingNormal[static_cast<std::size_t>(first + k)];
+    const Vec3 mid = 0.5 * (va.position + vb.position);
+    const Vec3 d = vb.position - va.position;
+    if (!(d.norm() > 0.0) || !((vb.pattern - va.pattern).norm() > 0.0))
+      return "a ruling has zero length";
+    planes[static_cast<std::size_t>(k)] = {normal, -normal.dot(mid), d.normalized()};
+    geometry[static_cast<std::size_t>(k)] = {va.position, vb.position, va.pattern, vb.pattern,
+                                             normal};
+    frame.centre += mid;
+    lengthSum += d.norm();
+  }
+  frame.centre /= n;
+  frame.length = kFarApex * ctx.paperLength;
+  if (!(lengthSum > 0.0)) return "the rulings have zero length";
+  return {};
+}
+
 }  // namespace
 
 // Outline parameter of a boundary vertex (paper Sec. 6.2: the boundary
@@ -273,35 +310,78 @@ std::string RunRefitter::fanRun(int apexChain) {
   return {};
 }
 
+// paper Sec. 6.2 / Fig. 15 last row: junction J of a run (before the
+// first cone, between cones, after the last one) joined on one ruling or
+// as a fan from a point of dS; the original rulings when `degraded`.
+Junction RunRefitter::resolveJunction(int J, bool degraded,
+                                      const std::vector<ConeSegment>& segments,
+                                      const std::vector<Pencil>& pencils) const {
+  const int n = last_ - first_ + 1;
+  const int nseg = static_cast<int>(segments.size());
+  const int iL = J == 0 ? 0 : segments[static_cast<std::size_t>(J - 1)].last;
+  const int iR = J == nseg ? n - 1 : segments[static_cast<std::size_t>(J)].first;
+  Junction out;
+  out.left = original(iL);
+  out.right = original(iR);
+  if (degraded) return out;
+  const Pencil* pl = J == 0 ? nullptr : &pencils[static_cast<std::size_t>(J - 1)];
+  const Pencil* pr = J == nseg ? nullptr : &pencils[static_cast<std::size_t>(J)];
+  std::optional<Junction> best;
+  double bestGap = 0.0;
+  for (int which : {iL, iR}) {
+    for (int c = 0; c < 2; ++c) {
+      const auto cu = static_cast<std::size_t>(c);
+      const auto ou = static_cast<std::size_t>(1 - c);
+      const ChainRuling base = original(which);
+      const double tb = base.t[cu];
+      const Chain& other = chains_[ou];
+      // The line of each side through b = (c, tb) and where it meets the other chain.
+      const auto sideHit = [&](const Pencil* p, int idx) -> std::optional<double> {
+        if (p == nullptr) {
+          const ChainRuling orig = original(idx);
+          if (std::abs(orig.t[cu] - tb) > eps_) return std::nullopt;  // b not on the kept ruling
+          return orig.t[ou];
+        }
+        return pencilHit(*p, c, tb, 0.0, other.length, original(idx).t[ou]);
+      };
+      const std::optional<double> hl = sideHit(pl, iL);
+      const std::optional<double> hr = sideHit(pr, iR);
+      if (!hl || !hr || *hl > *hr + eps_) continue;
+      const double gap = std::max(0.0, *hr - *hl);
+      if (best && gap >= bestGap) continue;
+      Junction j;
+      j.left.t[cu] = tb;
+      j.left.v[cu] = base.v[cu];
+      j.left.t[ou] = *hl;
+      j.right = j.left;
+      j.right.t[ou] = std::max(*hr, *hl);
+      if (pl == nullptr) j.left = original(iL);
+      if (pr == nullptr) j.right = original(iR);
+      j.fanChain = c;
+      j.shared = gap <= 1e-6 * ctx_.spacing;
+      if (j.shared) {
+        // One ruling joins both cones (a kept border when there is one).
+        j.right = pl == nullptr ? j.left : (pr == nullptr ? j.right : j.left);
+        j.left = j.right;
+      }
+      j.fan = !j.shared;
+      best = j;
+      bestGap = gap;
+    }
+  }
+  return best ? *best : out;
+}
+
 // paper Sec. 6.2 / thesis 2.5.2, Fig. 2.19: planes, segmentation, apices,
 // junction cones and the resampled cones of one run.
 std::string RunRefitter::coneRun() {
-  const GeometricMesh& g = *ctx_.g;
   const int n = last_ - first_ + 1;
   // 1. Tangent plane per ruling (paper Sec. 6.2: normals constant along the ruling).
-  std::vector<RulingPlane> planes(static_cast<std::size_t>(n));
-  std::vector<RulingGeometry> geometry(static_cast<std::size_t>(n));
-  FitFrame frame;
-  frame.centre = Vec3::Zero();
-  double lengthSum = 0.0;
-  for (int k = 0; k < n; ++k) {
-    const Ruling& r = ctx_.rulings[static_cast<std::size_t>(first_ + k)];
-    const GeometricVertex& va = g.vertices[static_cast<std::size_t>(r.a)];
-    const GeometricVertex& vb = g.vertices[static_cast<std::size_t>(r.b)];
-    const Vec3 normal = ctx_.rulingNormal[static_cast<std::size_t>(first_ + k)];
-    const Vec3 mid = 0.5 * (va.position + vb.position);
-    const Vec3 d = vb.position - va.position;
-    if (!(d.norm() > 0.0) || !((vb.pattern - va.pattern).norm() > 0.0))
-      return "a ruling has zero length";
-    planes[static_cast<std::size_t>(k)] = {normal, -normal.dot(mid), d.normalized()};
-    geometry[static_cast<std::size_t>(k)] = {va.position, vb.position, va.pattern, vb.pattern,
-                                             normal};
-    frame.centre += mid;
-    lengthSum += d.norm();
-  }
-  frame.centre /= n;
-  frame.length = kFarApex * ctx_.paperLength;
-  if (!(lengthSum > 0.0)) return "the rulings have zero length";
+  RunPlanes fit;
+  if (std::string why = runPlanes(ctx_, first_, n, fit); !why.empty()) return why;
+  const std::vector<RulingPlane>& planes = fit.planes;
+  const std::vector<RulingGeometry>& geometry = fit.geometry;
+  const FitFrame& frame = fit.frame;
 
   // 2. paper Sec. 6.2 iterative segmentation (disjoint segments, paper text).
   out_->segments = segmentRulings(planes, ctx_.tolerance, frame, false);
@@ -322,72 +402,13 @@ std::string RunRefitter::coneRun() {
   // 4. Junctions J = 0..nseg: before the first cone, between cones, after
   // the last one (paper Fig. 15 last row). L[J] ends the cone before, R[J]
   // starts the cone after; the region's borders are kept.
-  struct Junction {
-    ChainRuling left, right;
-    bool fan = false;
-    int fanChain = 0;
-    bool shared = false;
-  };
-  const auto resolve = [&](int J, bool degraded) {
-    const int iL = J == 0 ? 0 : segments[static_cast<std::size_t>(J - 1)].last;
-    const int iR = J == nseg ? n - 1 : segments[static_cast<std::size_t>(J)].first;
-    Junction out;
-    out.left = original(iL);
-    out.right = original(iR);
-    if (degraded) return out;
-    const Pencil* pl = J == 0 ? nullptr : &pencils[static_cast<std::size_t>(J - 1)];
-    const Pencil* pr = J == nseg ? nullptr : &pencils[static_cast<std::size_t>(J)];
-    std::optional<Junction> best;
-    double bestGap = 0.0;
-    for (int which : {iL, iR}) {
-      for (int c = 0; c < 2; ++c) {
-        const auto cu = static_cast<std::size_t>(c);
-        const auto ou = static_cast<std::size_t>(1 - c);
-        const ChainRuling base = original(which);
-        const double tb = base.t[cu];
-        const Chain& other = chains_[ou];
-        // The line of each side through b = (c, tb) and where it meets the other chain.
-        const auto sideHit = [&](const Pencil* p, int idx) -> std::optional<double> {
-          if (p == nullptr) {
-            const ChainRuling orig = original(idx);
-            if (std::abs(orig.t[cu] - tb) > eps_) return std::nullopt;  // b not on the kept ruling
-            return orig.t[ou];
-          }
-          return pencilHit(*p, c, tb, 0.0, other.length, original(idx).t[ou]);
-        };
-        const std::optional<double> hl = sideHit(pl, iL);
-        const std::optional<double> hr = sideHit(pr, iR);
-        if (!hl || !hr || *hl > *hr + eps_) continue;
-        const double gap = std::max(0.0, *hr - *hl);
-        if (best && gap >= bestGap) continue;
-        Junction j;
-        j.left.t[cu] = tb;
-        j.left.v[cu] = base.v[cu];
-        j.left.t[ou] = *hl;
-        j.right = j.left;
-        j.right.t[ou] = std::max(*hr, *hl);
-        if (pl == nullptr) j.left = original(iL);
-        if (pr == nullptr) j.right = original(iR);
-        j.fanChain = c;
-        j.shared = gap <= 1e-6 * ctx_.spacing;
-        if (j.shared) {
-          // One ruling joins both cones (a kept border when there is one).
-          j.right = pl == nullptr ? j.left : (pr == nullptr ? j.right : j.left);
-          j.left = j.right;
-        }
-        j.fan = !j.shared;
-        best = j;
-        bestGap = gap;
-      }
-    }
-    return best ? *best : out;
-  };
   std::vector<char> degraded(static_cast<std::size_t>(nseg + 1), 0);
   std::vector<Junction> junctions(static_cast<std::size_t>(nseg + 1));
   for (bool again = true; again;) {
     again = false;
     for (int J = 0; J <= nseg; ++J)
-      junctions[static_cast<std::size_t>(J)] = resolve(J, degraded[static_cast<std::size_t>(J)]);
+      junctions[static_cast<std::size_t>(J)] =
+          resolveJunction(J, degraded[static_cast<std::size_t>(J)], segments, pencils);
     for (int j = 0; j < nseg; ++j) {
       const ChainRuling& s = junctions[static_cast<std::size_t>(j)].right;
       const ChainRuling& e = junctions[static_cast<std::size_t>(j + 1)].left;

@@ -98,6 +98,15 @@ struct RunResult {
   int keptJunctions = 0;
 };
 
+// A junction between two cones of a run (or at a run's end): L ends the
+// cone before, R starts the cone after (paper Fig. 15 last row).
+struct Junction {
+  ChainRuling left, right;
+  bool fan = false;
+  int fanChain = 0;
+  bool shared = false;
+};
+
 // The data of the region the runs need.
 struct RegionContext {
   GeometricMesh* g = nullptr;
@@ -138,6 +147,8 @@ class RunRefitter {
   // paper Sec. 6.2: rulings of cone `pencil` strictly between s and e.
   std::string coneInterior(const Pencil& pencil, const ChainRuling& s, const ChainRuling& e,
                            std::vector<ChainRuling>& out) const;
+  Junction resolveJunction(int J, bool degraded, const std::vector<ConeSegment>& segments,
+                           const std::vector<Pencil>& pencils) const;
   std::optional<double> pencilHit(const Pencil& pencil, int c, double t, double lo, double hi,
                                   double guess) const;
   ChainRuling original(int k) const;  // run-local index k

@@ -364,26 +364,11 @@ int HybridSheet::interiorSingularVertexCount() const {
                     [](const GeometricVertex& v) { return v.singular && !v.onBoundary; }));
 }
 
-// One animation step of the paper (Fig. 16, thesis Algorithm 1) from t to
-// t + dt: an elastic step of S_P, S_P -> S_G, the geometric step, cone
-// fitting, S_P rebuilt from S_G, the isometry projection and (with
-// maxEdgeStrain) the strain limit. `stage` names
-// the stage running, for the error message when it throws.
-void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunction& nodePins,
-                                      int frame, int singularBudget, std::uint64_t& draw,
-                                      HybridStepStats& stats, const char*& stage) {
+// paper Fig. 16 (a)-(b): the elastic step of S_P from t over dt with the handles as hard
+// constraints, retried once with every pin on its target.
+void HybridSheet::Impl::elasticStep(double t, double dt, const sim::PinFunction& pins,
+                                    const sim::PinFunction& nodePins, HybridStepStats& stats) {
   Impl& m = *this;
-  // The handles on their nodes, a lagging one on its way back (catchUpPins).
-  const sim::PinFunction pins = m.catchUpPins(t, dt, nodePins);
-  // The step's start, for the strain limit's carried start and for undoing
-  // a structure change it cannot bound.
-  const mesh::SheetMesh spBefore = m.params.maxEdgeStrain > 0.0 ? m.sp.mesh : mesh::SheetMesh{};
-  const GeometricMesh sgBefore = m.params.maxEdgeStrain > 0.0 ? m.sg : GeometricMesh{};
-  CrumpleParams stepParams = m.params;
-  stepParams.maxSingularPerFrame = singularBudget;
-  // (a)-(b) elastic relaxation of S_P with the handles as hard constraints.
-  stage = "elastic";
-  auto t0 = Clock::now();
   const std::vector<Vec3> elasticStart =
       m.crossingGuard() > 0.0 ? m.elastic->positions() : std::vector<Vec3>{};
   m.elastic->setGrips(m.laggingGrips(pins, nodePins));
@@ -404,27 +389,14 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
     ++stats.elasticRetries;
   }
   if (!(m.keepElasticStepOutOfItself(elasticStart, dt) > 0.0)) ++stats.elasticHeldStill;
-  stats.ms.elastic = msSince(t0);
-  m.noteHinge(0);
-  const std::vector<sim::ContactSample> elasticContacts = m.elastic->contacts();
-  const std::vector<Vec2> elasticPattern = m.sp.mesh.pattern;
-  const std::vector<Vec3>& x = m.elastic->positions();
-  const std::vector<Vec3>& v = m.elastic->velocities();
-  // The elastic step's S_P, for undoing a geometric step that stretches it.
-  const std::vector<Vec3> elasticX = m.params.maxEdgeStrain > 0.0 ? x : std::vector<Vec3>{};
-  const std::vector<Vec3> elasticV = m.params.maxEdgeStrain > 0.0 ? v : std::vector<Vec3>{};
-  if (m.traceLevel > 0)
-    m.traceElasticStrain = LengthProjector(m.sp.mesh.pattern, m.sp.mesh.triangles).strain(x).first;
-  // (c) S_P -> S_G.
-  for (std::size_t i = 0; i < m.sg.vertices.size(); ++i) {
-    m.sg.vertices[i].position = x[i];
-    m.sg.vertices[i].velocity = v[i];
-  }
-  // (d)-(e) geometric step (thesis Algorithm 1).
-  stage = "geometric";
-  t0 = Clock::now();
-  const BoundaryCurve curve =
-      boundaryCurveFromMesh(m.sg, m.sp.mesh.pattern, x, 1e-9 * m.paperLength);
+}
+
+// paper Fig. 16 (d)-(e), thesis Algorithm 1: the geometric step of S_G (junctions, edge flips,
+// folded and split flat regions, compression treatment) with S_P at x after the elastic step.
+void HybridSheet::Impl::geometricStep(const BoundaryCurve& curve, const std::vector<Vec3>& x,
+                                      int frame, const CrumpleParams& stepParams,
+                                      std::uint64_t& draw, HybridStepStats& stats) {
+  Impl& m = *this;
   const BoundaryPosition boundary = [&curve](double s) { return curve.evaluate(s); };
   // With invariant checks on, every sub-step is checked so a failure names it.
   const auto checkAfter = [&](const char* step) {
@@ -453,10 +425,12 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
   checkAfter("compression treatment");
   treatCurvedCompression(m.sg, stepParams, rng, draw, stats.geometric, settled);
   checkAfter("curved-region compression");
-  stats.ms.geometric = msSince(t0);
-  // (f) generalized cones (paper Sec. 6.2).
-  stage = "cones";
-  t0 = Clock::now();
+}
+
+// paper Fig. 16 (f), Sec. 6.2: every curved region without an apex refitted as generalized
+// cones, each fit undone when it breaks S_G or compresses a ruling.
+void HybridSheet::Impl::refitCones(const BoundaryCurve& curve, HybridStepStats& stats) {
+  Impl& m = *this;
   for (std::size_t r = 0; r < m.sg.regions.size(); ++r) {
     const Region& region = m.sg.regions[r];
     if (region.type != mesh::RegionType::Curved || region.apex >= 0 || region.rulings.size() < 3)
@@ -494,29 +468,13 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
   // Faces created by the remeshing are flat only when coplanar: regions are
   // the maximal coplanar sets again before S_P is built.
   splitFlatRegions(m.sg, m.params);
-  stats.ms.cones = msSince(t0);
-  for (const GeometricVertex& gv : m.sg.vertices) {
-    if (!gv.position.allFinite())
-      throw NumericalError("geometric", frame, "S_G vertex position is not finite");
-  }
-  if (m.params.checkInvariants) {
-    const std::string problem = validate(m.sg, m.params.theta0);
-    if (!problem.empty())
-      throw NumericalError("geometric", frame, "S_G invariant broken: " + problem);
-  }
-  m.time = t + dt;
-  // (g) S_P from S_G.
-  stage = "rebuild";
-  t0 = Clock::now();
-  stats.topologyChanged = m.rebuildPhysical();
-  m.noteHinge(1);
-  stats.ms.rebuild = msSince(t0);
-  if (m.params.checkInvariants) m.checkInvariants(frame, "geometric");
-  // (h) isometry with the handles fixed (paper Sec. 6.3).
-  stage = "isometry";
-  t0 = Clock::now();
-  std::vector<sim::Pin> pinned;
-  pins(t + dt, pinned);
+}
+
+// paper Fig. 16 (h), Sec. 6.3: S_P's positions after the isometry projection with the handles
+// fixed (`pinned` at t), kept unprojected when it would pass S_P through itself or lengthen.
+std::vector<Vec3> HybridSheet::Impl::projectIsometry(double t, const std::vector<sim::Pin>& pinned,
+                                                     int frame, HybridStepStats& stats) {
+  Impl& m = *this;
   std::vector<int> fixed;
   for (const sim::Pin& p : pinned) {
     // Tangent-plane pins are S_P vertices that are not handles: they bind in
@@ -540,7 +498,7 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
     std::sort(all.begin(), all.end());
     all.erase(std::unique(all.begin(), all.end()), all.end());
     m.onProjection({m.sp.mesh.pattern, m.sp.mesh.triangles, fixed, all, m.sp.mesh.positions,
-                    m.isometryOptions(), m.params.isometryIterations, frame, t + dt});
+                    m.isometryOptions(), m.params.isometryIterations, frame, t});
   }
   std::vector<Vec3> positions = m.sp.mesh.positions;
   stats.isometry = m.isometry->project(positions, m.params.isometryIterations);
@@ -560,6 +518,102 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
     stats.isometry.meanLengthErrorAfter = stats.isometry.meanLengthErrorBefore;
     stats.isometry.meanDisplacement = 0.0;
   }
+  return positions;
+}
+
+// paper Fig. 16 (g) precondition: S_G after the geometric step and the cone fit has finite
+// positions and (checkInvariants) holds its invariants.
+void HybridSheet::Impl::checkGeometric(int frame) const {
+  const Impl& m = *this;
+  for (const GeometricVertex& gv : m.sg.vertices) {
+    if (!gv.position.allFinite())
+      throw NumericalError("geometric", frame, "S_G vertex position is not finite");
+  }
+  if (m.params.checkInvariants) {
+    const std::string problem = validate(m.sg, m.params.theta0);
+    if (!problem.empty())
+      throw NumericalError("geometric", frame, "S_G invariant broken: " + problem);
+  }
+}
+
+// paper Fig. 16 (h) end: S_P and S_G take the step's final positions; the cooldown of the
+// recent cuts advances and this step's cuts start theirs.
+void HybridSheet::Impl::commitPositions(const std::vector<Vec3>& positions,
+                                        const HybridStepStats& stats) {
+  Impl& m = *this;
+  m.sp.mesh.positions = positions;
+  for (std::size_t i = 0; i < m.sg.vertices.size(); ++i) m.sg.vertices[i].position = positions[i];
+  m.elastic->setPositions(positions);
+  m.noteHinge(2);
+  for (auto& cut : m.recentCuts) --cut.second;
+  std::erase_if(m.recentCuts, [](const auto& cut) { return cut.second <= 0; });
+  for (const Vec2& p : stats.geometric.cuts) m.recentCuts.emplace_back(p, m.params.remeshCooldown);
+}
+
+// One animation step of the paper (Fig. 16, thesis Algorithm 1) from t to
+// t + dt: an elastic step of S_P, S_P -> S_G, the geometric step, cone
+// fitting, S_P rebuilt from S_G, the isometry projection and (with
+// maxEdgeStrain) the strain limit. `stage` names
+// the stage running, for the error message when it throws.
+void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunction& nodePins,
+                                      int frame, int singularBudget, std::uint64_t& draw,
+                                      HybridStepStats& stats, const char*& stage) {
+  Impl& m = *this;
+  // The handles on their nodes, a lagging one on its way back (catchUpPins).
+  const sim::PinFunction pins = m.catchUpPins(t, dt, nodePins);
+  // The step's start, for the strain limit's carried start and for undoing
+  // a structure change it cannot bound.
+  const mesh::SheetMesh spBefore = m.params.maxEdgeStrain > 0.0 ? m.sp.mesh : mesh::SheetMesh{};
+  const GeometricMesh sgBefore = m.params.maxEdgeStrain > 0.0 ? m.sg : GeometricMesh{};
+  CrumpleParams stepParams = m.params;
+  stepParams.maxSingularPerFrame = singularBudget;
+  // (a)-(b) elastic relaxation of S_P with the handles as hard constraints.
+  stage = "elastic";
+  auto t0 = Clock::now();
+  m.elasticStep(t, dt, pins, nodePins, stats);
+  stats.ms.elastic = msSince(t0);
+  m.noteHinge(0);
+  const std::vector<sim::ContactSample> elasticContacts = m.elastic->contacts();
+  const std::vector<Vec2> elasticPattern = m.sp.mesh.pattern;
+  const std::vector<Vec3>& x = m.elastic->positions();
+  const std::vector<Vec3>& v = m.elastic->velocities();
+  // The elastic step's S_P, for undoing a geometric step that stretches it.
+  const std::vector<Vec3> elasticX = m.params.maxEdgeStrain > 0.0 ? x : std::vector<Vec3>{};
+  const std::vector<Vec3> elasticV = m.params.maxEdgeStrain > 0.0 ? v : std::vector<Vec3>{};
+  if (m.traceLevel > 0)
+    m.traceElasticStrain = LengthProjector(m.sp.mesh.pattern, m.sp.mesh.triangles).strain(x).first;
+  // (c) S_P -> S_G.
+  for (std::size_t i = 0; i < m.sg.vertices.size(); ++i) {
+    m.sg.vertices[i].position = x[i];
+    m.sg.vertices[i].velocity = v[i];
+  }
+  // (d)-(e) geometric step (thesis Algorithm 1).
+  stage = "geometric";
+  t0 = Clock::now();
+  const BoundaryCurve curve =
+      boundaryCurveFromMesh(m.sg, m.sp.mesh.pattern, x, 1e-9 * m.paperLength);
+  m.geometricStep(curve, x, frame, stepParams, draw, stats);
+  stats.ms.geometric = msSince(t0);
+  // (f) generalized cones (paper Sec. 6.2).
+  stage = "cones";
+  t0 = Clock::now();
+  m.refitCones(curve, stats);
+  stats.ms.cones = msSince(t0);
+  m.checkGeometric(frame);
+  m.time = t + dt;
+  // (g) S_P from S_G.
+  stage = "rebuild";
+  t0 = Clock::now();
+  stats.topologyChanged = m.rebuildPhysical();
+  m.noteHinge(1);
+  stats.ms.rebuild = msSince(t0);
+  if (m.params.checkInvariants) m.checkInvariants(frame, "geometric");
+  // (h) isometry with the handles fixed (paper Sec. 6.3).
+  stage = "isometry";
+  t0 = Clock::now();
+  std::vector<sim::Pin> pinned;
+  pins(t + dt, pinned);
+  std::vector<Vec3> positions = m.projectIsometry(t + dt, pinned, frame, stats);
   stats.ms.isometry = msSince(t0);
   if (m.params.maxEdgeStrain > 0.0) {
     stage = "strain limit";
@@ -589,13 +643,7 @@ void HybridSheet::Impl::animationStep(double t, double dt, const sim::PinFunctio
     stage = "isometry";
   }
   t0 = Clock::now();
-  m.sp.mesh.positions = positions;
-  for (std::size_t i = 0; i < m.sg.vertices.size(); ++i) m.sg.vertices[i].position = positions[i];
-  m.elastic->setPositions(positions);
-  m.noteHinge(2);
-  for (auto& cut : m.recentCuts) --cut.second;
-  std::erase_if(m.recentCuts, [](const auto& cut) { return cut.second <= 0; });
-  for (const Vec2& p : stats.geometric.cuts) m.recentCuts.emplace_back(p, m.params.remeshCooldown);
+  m.commitPositions(positions, stats);
   stats.ms.isometry += msSince(t0);
   if (m.traceLevel > 0) {
     std::vector<sim::Pin> pinned;

@@ -17,6 +17,7 @@
 
 #include "crumple/core/error.hpp"
 #include "crumple/core/geometry2d.hpp"
+#include "crumple/paper/boundary_curve.hpp"
 #include "crumple/paper/damage.hpp"
 #include "crumple/paper/hybrid_sheet.hpp"
 #include "crumple/sim/colliders.hpp"
@@ -180,6 +181,18 @@ struct HybridSheet::Impl {
         out[static_cast<std::size_t>(p.vertex)] = 1;
     return out;
   }
+  // The stages of animationStep (paper Fig. 16): (a)-(b) the elastic step, (d)-(e) the
+  // geometric step, (f) the cone fit, S_G's checks, (h) the isometry projection and the
+  // positions it leaves.
+  void elasticStep(double t, double dt, const sim::PinFunction& pins,
+                   const sim::PinFunction& nodePins, HybridStepStats& stats);
+  void geometricStep(const BoundaryCurve& curve, const std::vector<Vec3>& x, int frame,
+                     const CrumpleParams& stepParams, std::uint64_t& draw, HybridStepStats& stats);
+  void refitCones(const BoundaryCurve& curve, HybridStepStats& stats);
+  void checkGeometric(int frame) const;
+  std::vector<Vec3> projectIsometry(double t, const std::vector<sim::Pin>& pinned, int frame,
+                                    HybridStepStats& stats);
+  void commitPositions(const std::vector<Vec3>& positions, const HybridStepStats& stats);
   void animationStep(double t, double dt, const sim::PinFunction& nodePins, int frame,
                      int singularBudget, std::uint64_t& draw, HybridStepStats& stats,
                      const char*& stage);

@@ -370,6 +370,296 @@ int bendFoldedFlatRegions(GeometricMesh& g, const CrumpleParams& params,
   return bent;
 }
 
+namespace {
+
+// The state the compression treatment of one step shares between regions.
+struct CompressionStep {
+  GeometricMesh& g;
+  const CrumpleParams& params;
+  const BoundaryPosition& boundary;
+  const CounterRng& rng;
+  std::uint64_t& drawIndex;
+  GeometricStepStats& stats;
+  detail::EdgeMapCache& edgeCache;
+  std::vector<char>& declined;  // per region: waits for a later step
+};
+
+// thesis 2.4.2: the regions by their most compressed flat triangle, most compressed first.
+std::vector<std::pair<double, std::size_t>> regionsByCompression(const GeometricMesh& g) {
+  const std::size_t regionCount = g.regions.size();
+  std::vector<std::pair<double, std::size_t>> order;
+  std::vector<double> worst(regionCount, 0.0);
+  for (const GeometricFace& face : g.faces) {
+    if (face.size() != 3 ||
+        g.regions[static_cast<std::size_t>(face.region)].type != mesh::RegionType::Flat) {
+      continue;
+    }
+    double& w = worst[static_cast<std::size_t>(face.region)];
+    w = std::max(w, faceCompression(g, face).ratio());
+  }
+  for (std::size_t r = 0; r < regionCount; ++r) order.emplace_back(-worst[r], r);
+  std::sort(order.begin(), order.end());
+  return order;
+}
+
+// paper Sec. 5.1 (a): region r's most compressed triangle (-1: none) and its compression.
+int mostCompressedTriangle(const GeometricMesh& g, std::size_t r, TriangleCompression& best) {
+  int tcomp = -1;
+  best.lambdaMin = 2.0;
+  for (std::size_t f = 0; f < g.faces.size(); ++f) {
+    const GeometricFace& face = g.faces[f];
+    if (face.region != static_cast<int>(r) || face.size() != 3) continue;
+    const TriangleCompression c = faceCompression(g, face);
+    if (c.lambdaMin < best.lambdaMin) {
+      best = c;
+      tcomp = static_cast<int>(f);
+    }
+  }
+  return tcomp;
+}
+
+// paper Sec. 5.2, Appendix B Fig. 24 b: the existing d-cone apex each strip border ends at;
+// false when a border is a ruling of a cone whose apex it does not hold.
+bool existingApices(const GeometricMesh& g, const detail::Loop& loop,
+                    const Border* const (&borders)[2], int (&existingApex)[2]) {
+  bool feasible = true;
+  for (int side = 0; side < 2; ++side) {
+    const Border& b = *borders[side];
+    if (b.kind == Border::Kind::FlatFlat) {
+      // A border edge ending at a singular vertex (e.g. a crease between
+      // two): the rulings are attracted by that existing d-cone apex
+      // (Appendix B, Fig. 24 b) instead of a new one beside it.
+      const int ea = loop.v[static_cast<std::size_t>(b.loopEdge)];
+      const int eb = loop.next(static_cast<std::size_t>(b.loopEdge));
+      const bool sa = g.vertices[static_cast<std::size_t>(ea)].singular;
+      const bool sb = g.vertices[static_cast<std::size_t>(eb)].singular;
+      if (sa || sb) {
+        const double da = (g.vertices[static_cast<std::size_t>(ea)].pattern - b.hit).norm();
+        const double db = (g.vertices[static_cast<std::size_t>(eb)].pattern - b.hit).norm();
+        existingApex[side] = sa && (!sb || da <= db) ? ea : eb;
+      }
+      continue;
+    }
+    if (b.kind != Border::Kind::Curved) continue;
+    const int across = loop.across[static_cast<std::size_t>(b.loopEdge)];
+    const int apex =
+        g.regions[static_cast<std::size_t>(g.faces[static_cast<std::size_t>(across)].region)].apex;
+    if (apex < 0) continue;
+    const int ea = loop.v[static_cast<std::size_t>(b.loopEdge)];
+    const int eb = loop.next(static_cast<std::size_t>(b.loopEdge));
+    if (apex == ea || apex == eb) {
+      existingApex[side] = apex;
+    } else {
+      feasible = false;
+    }
+  }
+  return feasible;
+}
+
+// paper Sec. 5.2 (thesis 2.4.3): a singular vertex on each constrained border of the strip
+// that has no existing apex; singular[side] stays -1 where the insertion fails.
+void insertBorderSingulars(CompressionStep& step, std::size_t r, const Vec2& centroid,
+                           const Vec2& vPerp, double tol, const Border* const (&borders)[2],
+                           const int (&existingApex)[2], int (&singular)[2]) {
+  GeometricMesh& g = step.g;
+  const auto constrained = [](const Border& b) { return b.kind != Border::Kind::Free; };
+  for (int side = 0; side < 2; ++side) {
+    if (existingApex[side] >= 0) {
+      singular[side] = existingApex[side];
+      continue;
+    }
+    if (!constrained(*borders[side])) continue;
+    const EdgeMap e2 = edgeMap(g);
+    const auto l2 = regionLoop(g, static_cast<int>(r), e2);
+    if (!l2) break;
+    // Re-locate the border edge in the current loop (the other side's
+    // insertion may have renumbered it).
+    const Border b = findBorder(g, *l2, centroid, side == 0 ? Vec2(-vPerp) : vPerp, tol);
+    if (b.kind == Border::Kind::Curved) {
+      singular[side] = insertSingularInCurved(g, static_cast<int>(r), *l2, b, step.params, step.rng,
+                                              step.drawIndex);
+      if (singular[side] < 0) break;
+    } else {
+      singular[side] = placeSingularOnBorder(g, *l2, b, step.params, step.rng, step.drawIndex);
+      if (singular[side] < 0) break;
+    }
+    ++step.stats.singularInserted;
+  }
+}
+
+// paper Appendix B, Fig. 24: region r remeshed as a crease between two singular vertices,
+// a cone of rulings from one, or a strip of parallel rulings along vPerp.
+StripResult remeshCompressedStrip(CompressionStep& step, std::size_t r, const Vec2& centroid,
+                                  const Vec2& vPerp, double tol, const Border* const (&borders)[2],
+                                  const int (&existingApex)[2], const int (&singular)[2]) {
+  GeometricMesh& g = step.g;
+  GeometricStepStats& stats = step.stats;
+  StripResult result;
+  // Rulings fanning from the apex on `side`: aimed where the strip
+  // meets the other border (free there by construction), else through
+  // the compressed triangle.
+  const auto coneFrom = [&](int apex, int side) {
+    Pencil pencil;
+    pencil.apex = apex;
+    const Vec2 s = g.vertices[static_cast<std::size_t>(apex)].pattern;
+    pencil.origin = s;
+    StripResult out{false, "no pencil"};
+    for (const Vec2& target : {borders[1 - side]->hit, centroid}) {
+      if (!((target - s).norm() > tol)) continue;
+      pencil.dir = (target - s).normalized();
+      out = remeshStrip(g, static_cast<int>(r), pencil, step.params, step.boundary);
+      if (out.done) break;
+    }
+    return out;
+  };
+  if (singular[0] >= 0 && singular[1] >= 0) {
+    result.done = splitAlongCrease(g, static_cast<int>(r), singular[0], singular[1]);
+    if (result.done) ++stats.creases;
+    // Two existing apices that are one vertex, or already joined by a
+    // border edge, leave no crease to cut: the strip's rulings fan
+    // from one of them instead (Appendix B, Fig. 24 b).
+    for (int side = 0; side < 2 && !result.done; ++side) {
+      if (existingApex[side] < 0) continue;
+      result = coneFrom(existingApex[side], side);
+      if (result.done) ++stats.curvedCreated;
+    }
+  } else {
+    if (singular[0] >= 0 || singular[1] >= 0) {
+      result = singular[0] >= 0 ? coneFrom(singular[0], 0) : coneFrom(singular[1], 1);
+    } else {
+      Pencil pencil;
+      pencil.origin = centroid;
+      pencil.dir = vPerp;
+      result = remeshStrip(g, static_cast<int>(r), pencil, step.params, step.boundary);
+    }
+    if (result.done) ++stats.curvedCreated;
+  }
+  return result;
+}
+
+// The cuts of a strip made (its triangle's centroid, its singular vertices) for the cooldown.
+void recordStrip(const GeometricMesh& g, const Vec2& centroid, const int (&singular)[2],
+                 std::size_t singularBefore, std::ostringstream& why, GeometricStepStats& stats) {
+  stats.cuts.push_back(centroid);
+  if (stats.singularInserted > static_cast<int>(singularBefore)) {
+    why << "strip with " << (stats.singularInserted - static_cast<int>(singularBefore))
+        << " new singular vertices";
+    stats.notes.push_back(why.str());
+  }
+  for (int sv : singular) {
+    if (sv >= 0 && static_cast<std::size_t>(sv) < g.vertices.size()) {
+      stats.cuts.push_back(g.vertices[static_cast<std::size_t>(sv)].pattern);
+    }
+  }
+}
+
+// paper Sec. 5.1-5.2, Appendices A-B: flat region r's most compressed triangle made a strip
+// of rulings, as a transaction; whether S_G changed.
+bool treatCompressedRegion(CompressionStep& step, std::size_t r) {
+  GeometricMesh& g = step.g;
+  const CrumpleParams& params = step.params;
+  GeometricStepStats& stats = step.stats;
+  std::vector<char>& declined = step.declined;
+  // (a) the most compressed triangle and its direction of minimal compression.
+  TriangleCompression best;
+  const int tcomp = mostCompressedTriangle(g, r, best);
+  if (tcomp < 0) return false;
+  stats.maxCompression = std::max(stats.maxCompression, best.ratio());
+  if (!(best.ratio() > params.epsC)) return false;
+  const GeometricFace tri = g.faces[static_cast<std::size_t>(tcomp)];
+  Vec2 centroid = Vec2::Zero();
+  for (int k = 0; k < 3; ++k)
+    centroid += g.vertices[static_cast<std::size_t>(tri.v[k])].pattern / 3.0;
+  // Each remeshing is a transaction: S_G is checked afterwards and
+  // restored (the region declined for this step) when it would break an
+  // invariant, so one bad case cannot corrupt the sheet.
+  const GeometricMesh before = g;
+  const std::size_t singularBefore = static_cast<std::size_t>(stats.singularInserted);
+  const auto rollback = [&](const std::string& why) {
+    g = before;
+    stats.singularInserted = static_cast<int>(singularBefore);
+    stats.notes.push_back("flat region " + std::to_string(r) + ": remeshing undone (" + why + ")");
+    declined.resize(g.regions.size(), 0);
+    declined[r] = 1;
+  };
+  try {
+    // (b) the borders of the strip along +-v_perp (Appendix A, Fig. 6).
+    const EdgeMap& edges = step.edgeCache.of(g);
+    const auto loop = regionLoop(g, static_cast<int>(r), edges);
+    if (!loop) {
+      declined[r] = 1;
+      return false;
+    }
+    const double tol = 1e-10 * std::sqrt(outlineArea(g));
+    const Border fwd = findBorder(g, *loop, centroid, best.vPerp, tol);
+    const Border bwd = findBorder(g, *loop, centroid, -best.vPerp, tol);
+    std::ostringstream why;
+    why << "flat region " << r << " compressed " << best.ratio() << ": ";
+    if (fwd.kind == Border::Kind::None || bwd.kind == Border::Kind::None) {
+      why << "strip ends on a vertex that is not on the sheet boundary";
+      stats.notes.push_back(why.str());
+      declined[r] = 1;
+      return false;
+    }
+    // (c) remesh: c1 with both borders free, c2 with singular vertices.
+    const auto constrained = [](const Border& b) { return b.kind != Border::Kind::Free; };
+    const Border* const borders[2] = {&bwd, &fwd};
+    // Singular vertices on constrained borders (paper Sec. 5.2). A border
+    // ruling of a curved region gets its singular vertex on the ruling
+    // itself (we do not yet continue into the curved region to e_sing).
+    // A border ruling of a cone from a singular vertex s: the strip's
+    // rulings are attracted by s itself (Appendix B, Fig. 24 b), no new
+    // singular vertex is needed.
+    int singular[2] = {-1, -1};
+    int existingApex[2] = {-1, -1};
+    if (!existingApices(g, *loop, borders, existingApex)) {
+      why << "the strip meets a conical curved region";
+      stats.notes.push_back(why.str());
+      declined[r] = 1;
+      return false;
+    }
+    const int needed = (constrained(bwd) && existingApex[0] < 0 ? 1 : 0) +
+                       (constrained(fwd) && existingApex[1] < 0 ? 1 : 0);
+    if (needed > 0 && stats.singularInserted + needed > params.maxSingularPerFrame) {
+      why << "singular-vertex budget of this step used up";
+      stats.notes.push_back(why.str());
+      declined[r] = 1;
+      return false;
+    }
+    insertBorderSingulars(step, r, centroid, best.vPerp, tol, borders, existingApex, singular);
+    if ((constrained(bwd) && singular[0] < 0) || (constrained(fwd) && singular[1] < 0)) {
+      // The other side's singular vertex may be in S_G already: undone
+      // with the rest, as a failed remeshing is.
+      why << "the strip meets a conical curved region";
+      rollback(why.str());
+      return false;
+    }
+    const StripResult result =
+        remeshCompressedStrip(step, r, centroid, best.vPerp, tol, borders, existingApex, singular);
+    if (!result.done) {
+      // Undo the singular vertices placed for it too: a singular vertex
+      // without its cone would be damage without a cause.
+      why << (result.note.empty() ? std::string("the crease could not split the region")
+                                  : result.note);
+      rollback(why.str());
+      return false;
+    }
+    if (const std::string problem = validate(g); !problem.empty()) {
+      rollback(problem);
+      return false;
+    }
+    recordStrip(g, centroid, singular, singularBefore, why, stats);
+    return true;
+  } catch (const std::exception& e) {
+    // CDT refusing a polygon, a degenerate placement...: undo, go on.
+    rollback(e.what());
+    return false;
+  }
+}
+
+}  // namespace
+
+// paper Sec. 5.1-5.2 and Appendices A-B; thesis 2.4.2-2.4.3.
 void treatCompression(GeometricMesh& g, const CrumpleParams& params,
                       const BoundaryPosition& boundary, const CounterRng& rng,
                       std::uint64_t& drawIndex, GeometricStepStats& stats,
@@ -380,6 +670,7 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
   for (std::size_t f = 0; f < g.faces.size() && mayRemesh; ++f) {
     if (!mayRemesh(static_cast<int>(f))) declined[static_cast<std::size_t>(g.faces[f].region)] = 1;
   }
+  CompressionStep step{g, params, boundary, rng, drawIndex, stats, edgeCache, declined};
   // Regions are processed in id order, once per step: regions created here
   // keep the compressed vertices they were cut from and are looked at again
   // after the next elastic step has relaxed them (thesis 2.4.2 repeats the
@@ -393,231 +684,11 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
     declined.resize(regionCount, 0);
     // Most compressed regions first, so the per-step budget of singular
     // vertices goes where the conflict is strongest.
-    std::vector<std::pair<double, std::size_t>> order;
-    {
-      std::vector<double> worst(regionCount, 0.0);
-      for (const GeometricFace& face : g.faces) {
-        if (face.size() != 3 ||
-            g.regions[static_cast<std::size_t>(face.region)].type != mesh::RegionType::Flat) {
-          continue;
-        }
-        double& w = worst[static_cast<std::size_t>(face.region)];
-        w = std::max(w, faceCompression(g, face).ratio());
-      }
-      for (std::size_t r = 0; r < regionCount; ++r) order.emplace_back(-worst[r], r);
-      std::sort(order.begin(), order.end());
-    }
+    const std::vector<std::pair<double, std::size_t>> order = regionsByCompression(g);
     for (const auto& entry : order) {
-      const std::size_t r = entry.second;  // a plain local: lambdas below capture it
+      const std::size_t r = entry.second;
       if (declined[r] || g.regions[r].type != mesh::RegionType::Flat) continue;
-      // (a) the most compressed triangle and its direction of minimal compression.
-      int tcomp = -1;
-      TriangleCompression best;
-      best.lambdaMin = 2.0;
-      for (std::size_t f = 0; f < g.faces.size(); ++f) {
-        const GeometricFace& face = g.faces[f];
-        if (face.region != static_cast<int>(r) || face.size() != 3) continue;
-        const TriangleCompression c = faceCompression(g, face);
-        if (c.lambdaMin < best.lambdaMin) {
-          best = c;
-          tcomp = static_cast<int>(f);
-        }
-      }
-      if (tcomp < 0) continue;
-      stats.maxCompression = std::max(stats.maxCompression, best.ratio());
-      if (!(best.ratio() > params.epsC)) continue;
-      const GeometricFace tri = g.faces[static_cast<std::size_t>(tcomp)];
-      Vec2 centroid = Vec2::Zero();
-      for (int k = 0; k < 3; ++k)
-        centroid += g.vertices[static_cast<std::size_t>(tri.v[k])].pattern / 3.0;
-      // Each remeshing is a transaction: S_G is checked afterwards and
-      // restored (the region declined for this step) when it would break an
-      // invariant, so one bad case cannot corrupt the sheet.
-      const GeometricMesh before = g;
-      const std::size_t singularBefore = static_cast<std::size_t>(stats.singularInserted);
-      const auto rollback = [&](const std::string& why) {
-        g = before;
-        stats.singularInserted = static_cast<int>(singularBefore);
-        stats.notes.push_back("flat region " + std::to_string(r) + ": remeshing undone (" + why +
-                              ")");
-        declined.resize(g.regions.size(), 0);
-        declined[r] = 1;
-      };
-      try {
-        // (b) the borders of the strip along +-v_perp (Appendix A, Fig. 6).
-        const EdgeMap& edges = edgeCache.of(g);
-        const auto loop = regionLoop(g, static_cast<int>(r), edges);
-        if (!loop) {
-          declined[r] = 1;
-          continue;
-        }
-        const double tol = 1e-10 * std::sqrt(outlineArea(g));
-        const Border fwd = findBorder(g, *loop, centroid, best.vPerp, tol);
-        const Border bwd = findBorder(g, *loop, centroid, -best.vPerp, tol);
-        std::ostringstream why;
-        why << "flat region " << r << " compressed " << best.ratio() << ": ";
-        if (fwd.kind == Border::Kind::None || bwd.kind == Border::Kind::None) {
-          why << "strip ends on a vertex that is not on the sheet boundary";
-          stats.notes.push_back(why.str());
-          declined[r] = 1;
-          continue;
-        }
-        // (c) remesh: c1 with both borders free, c2 with singular vertices.
-        const auto constrained = [](const Border& b) { return b.kind != Border::Kind::Free; };
-        const Border* borders[2] = {&bwd, &fwd};
-        // Singular vertices on constrained borders (paper Sec. 5.2). A border
-        // ruling of a curved region gets its singular vertex on the ruling
-        // itself (we do not yet continue into the curved region to e_sing).
-        // A border ruling of a cone from a singular vertex s: the strip's
-        // rulings are attracted by s itself (Appendix B, Fig. 24 b), no new
-        // singular vertex is needed.
-        StripResult result;
-        int singular[2] = {-1, -1};
-        bool feasible = true;
-        int existingApex[2] = {-1, -1};
-        for (int side = 0; side < 2; ++side) {
-          const Border& b = *borders[side];
-          if (b.kind == Border::Kind::FlatFlat) {
-            // A border edge ending at a singular vertex (e.g. a crease between
-            // two): the rulings are attracted by that existing d-cone apex
-            // (Appendix B, Fig. 24 b) instead of a new one beside it.
-            const int ea = loop->v[static_cast<std::size_t>(b.loopEdge)];
-            const int eb = loop->next(static_cast<std::size_t>(b.loopEdge));
-            const bool sa = g.vertices[static_cast<std::size_t>(ea)].singular;
-            const bool sb = g.vertices[static_cast<std::size_t>(eb)].singular;
-            if (sa || sb) {
-              const double da = (g.vertices[static_cast<std::size_t>(ea)].pattern - b.hit).norm();
-              const double db = (g.vertices[static_cast<std::size_t>(eb)].pattern - b.hit).norm();
-              existingApex[side] = sa && (!sb || da <= db) ? ea : eb;
-            }
-            continue;
-          }
-          if (b.kind != Border::Kind::Curved) continue;
-          const int across = loop->across[static_cast<std::size_t>(b.loopEdge)];
-          const int apex =
-              g.regions[static_cast<std::size_t>(g.faces[static_cast<std::size_t>(across)].region)]
-                  .apex;
-          if (apex < 0) continue;
-          const int ea = loop->v[static_cast<std::size_t>(b.loopEdge)];
-          const int eb = loop->next(static_cast<std::size_t>(b.loopEdge));
-          if (apex == ea || apex == eb) {
-            existingApex[side] = apex;
-          } else {
-            feasible = false;
-          }
-        }
-        if (!feasible) {
-          why << "the strip meets a conical curved region";
-          stats.notes.push_back(why.str());
-          declined[r] = 1;
-          continue;
-        }
-        const int needed = (constrained(bwd) && existingApex[0] < 0 ? 1 : 0) +
-                           (constrained(fwd) && existingApex[1] < 0 ? 1 : 0);
-        if (needed > 0 && stats.singularInserted + needed > params.maxSingularPerFrame) {
-          why << "singular-vertex budget of this step used up";
-          stats.notes.push_back(why.str());
-          declined[r] = 1;
-          continue;
-        }
-        for (int side = 0; side < 2; ++side) {
-          if (existingApex[side] >= 0) {
-            singular[side] = existingApex[side];
-            continue;
-          }
-          if (!constrained(*borders[side])) continue;
-          const EdgeMap e2 = edgeMap(g);
-          const auto l2 = regionLoop(g, static_cast<int>(r), e2);
-          if (!l2) break;
-          // Re-locate the border edge in the current loop (the other side's
-          // insertion may have renumbered it).
-          const Border b =
-              findBorder(g, *l2, centroid, side == 0 ? Vec2(-best.vPerp) : best.vPerp, tol);
-          if (b.kind == Border::Kind::Curved) {
-            singular[side] =
-                insertSingularInCurved(g, static_cast<int>(r), *l2, b, params, rng, drawIndex);
-            if (singular[side] < 0) break;
-          } else {
-            singular[side] = placeSingularOnBorder(g, *l2, b, params, rng, drawIndex);
-            if (singular[side] < 0) break;
-          }
-          ++stats.singularInserted;
-        }
-        if ((constrained(bwd) && singular[0] < 0) || (constrained(fwd) && singular[1] < 0)) {
-          // The other side's singular vertex may be in S_G already: undone
-          // with the rest, as a failed remeshing is.
-          why << "the strip meets a conical curved region";
-          rollback(why.str());
-          continue;
-        }
-        // Rulings fanning from the apex on `side`: aimed where the strip
-        // meets the other border (free there by construction), else through
-        // the compressed triangle.
-        const auto coneFrom = [&](int apex, int side) {
-          Pencil pencil;
-          pencil.apex = apex;
-          const Vec2 s = g.vertices[static_cast<std::size_t>(apex)].pattern;
-          pencil.origin = s;
-          StripResult out{false, "no pencil"};
-          for (const Vec2& target : {borders[1 - side]->hit, centroid}) {
-            if (!((target - s).norm() > tol)) continue;
-            pencil.dir = (target - s).normalized();
-            out = remeshStrip(g, static_cast<int>(r), pencil, params, boundary);
-            if (out.done) break;
-          }
-          return out;
-        };
-        if (singular[0] >= 0 && singular[1] >= 0) {
-          result.done = splitAlongCrease(g, static_cast<int>(r), singular[0], singular[1]);
-          if (result.done) ++stats.creases;
-          // Two existing apices that are one vertex, or already joined by a
-          // border edge, leave no crease to cut: the strip's rulings fan
-          // from one of them instead (Appendix B, Fig. 24 b).
-          for (int side = 0; side < 2 && !result.done; ++side) {
-            if (existingApex[side] < 0) continue;
-            result = coneFrom(existingApex[side], side);
-            if (result.done) ++stats.curvedCreated;
-          }
-        } else {
-          if (singular[0] >= 0 || singular[1] >= 0) {
-            result = singular[0] >= 0 ? coneFrom(singular[0], 0) : coneFrom(singular[1], 1);
-          } else {
-            Pencil pencil;
-            pencil.origin = centroid;
-            pencil.dir = best.vPerp;
-            result = remeshStrip(g, static_cast<int>(r), pencil, params, boundary);
-          }
-          if (result.done) ++stats.curvedCreated;
-        }
-        if (!result.done) {
-          // Undo the singular vertices placed for it too: a singular vertex
-          // without its cone would be damage without a cause.
-          why << (result.note.empty() ? std::string("the crease could not split the region")
-                                      : result.note);
-          rollback(why.str());
-          continue;
-        }
-        if (const std::string problem = validate(g); !problem.empty()) {
-          rollback(problem);
-          continue;
-        }
-        stats.cuts.push_back(centroid);
-        if (stats.singularInserted > static_cast<int>(singularBefore)) {
-          why << "strip with " << (stats.singularInserted - static_cast<int>(singularBefore))
-              << " new singular vertices";
-          stats.notes.push_back(why.str());
-        }
-        for (int sv : singular) {
-          if (sv >= 0 && static_cast<std::size_t>(sv) < g.vertices.size()) {
-            stats.cuts.push_back(g.vertices[static_cast<std::size_t>(sv)].pattern);
-          }
-        }
-        changed = true;
-      } catch (const std::exception& e) {
-        // CDT refusing a polygon, a degenerate placement...: undo, go on.
-        rollback(e.what());
-        continue;
-      }
+      if (treatCompressedRegion(step, r)) changed = true;
     }
     if (!changed) break;
   }

@@ -169,32 +169,9 @@ void rebuildOutline(GeometricMesh& g, const Vec2& firstCorner, double perimeter)
   }
 }
 
-}  // namespace
-
-// thesis 3.3.3 "Remeshing", Figs. 3.20-3.23.
-std::optional<GeometricCutResult> cutGeometricMesh(GeometricMesh& g, const Vec2& from,
-                                                   const Vec2& to,
-                                                   const GeometricCutOptions& options,
-                                                   const std::optional<Vec2>& previousDirection) {
-  if (!(options.kerf > 0.0) || !std::isfinite(options.kerf))
-    throw std::invalid_argument("cutGeometricMesh: kerf must be finite and > 0");
-  if (!from.allFinite() || !to.allFinite())
-    throw std::invalid_argument("cutGeometricMesh: non-finite advance");
-  if (previousDirection) {
-    const Vec2 d = to - from;
-    const double turn =
-        std::atan2(std::abs(cross2(*previousDirection, d)), previousDirection->dot(d));
-    if (turn > options.maxTurn)
-      throw std::invalid_argument("cutGeometricMesh: the tear would turn back by " +
-                                  std::to_string(turn * 180.0 / std::numbers::pi) + " degrees");
-  }
-  GeometricMesh h = g;
-  const double perimeter = outlinePerimeter(h);
-  const double tol = 1e-9 * perimeter;
-  const double w = options.kerf;
-  GeometricCutResult result;
-
-  // Cases 1-2 to case 3: the curved regions the advance touches become flat.
+// thesis 3.3.3 cases 1-2 (Figs. 3.21-3.22) reduced to case 3: the curved regions the advance
+// [from, to] touches become flat; returns how many.
+int flattenTouchedRegions(GeometricMesh& h, const Vec2& from, const Vec2& to, double tol) {
   std::set<int> curved;
   for (std::size_t f = 0; f < h.faces.size(); ++f) {
     const int r = h.faces[f].region;
@@ -203,26 +180,51 @@ std::optional<GeometricCutResult> cutGeometricMesh(GeometricMesh& g, const Vec2&
       curved.insert(r);
   }
   for (int r : curved) flattenRegion(h, r);
-  result.regionsFlattened = static_cast<int>(curved.size());
+  return static_cast<int>(curved.size());
+}
 
-  // S_G's faces as a triangle mesh; each triangle's region is its S_G face.
+// Adds triangle (a, b, c) of S_G face `face` to the cut's triangle mesh.
+void addTriangle(mesh::SheetMesh& sm, int a, int b, int c, int face) {
+  sm.triangles.push_back({a, b, c});
+  sm.regionOfTriangle.push_back(face);
+}
+
+// S_G's faces as a triangle mesh for tear::cutAlong; each triangle's region is its S_G face.
+mesh::SheetMesh triangleMesh(const GeometricMesh& h) {
   mesh::SheetMesh sm;
   for (const GeometricVertex& v : h.vertices) {
     sm.pattern.push_back(v.pattern);
     sm.positions.push_back(v.position);
   }
-  const auto addTriangle = [&](int a, int b, int c, int face) {
-    sm.triangles.push_back({a, b, c});
-    sm.regionOfTriangle.push_back(face);
-  };
   for (std::size_t f = 0; f < h.faces.size(); ++f) {
     const auto& v = h.faces[f].v;
-    addTriangle(v[0], v[1], v[2], static_cast<int>(f));
-    if (h.faces[f].size() == 4) addTriangle(v[0], v[2], v[3], static_cast<int>(f));
+    addTriangle(sm, v[0], v[1], v[2], static_cast<int>(f));
+    if (h.faces[f].size() == 4) addTriangle(sm, v[0], v[2], v[3], static_cast<int>(f));
   }
   sm.regionTypes.assign(h.faces.size(), mesh::RegionType::Flat);
+  return sm;
+}
 
-  // s_t: an S_G outline vertex, or a new one on the outline edge holding it.
+// Splits sm's triangle holding the directed outline edge a -> b at v, a new vertex on it.
+void splitOutlineTriangle(mesh::SheetMesh& sm, int a, int b, int v) {
+  for (std::size_t t = 0; t < sm.triangles.size(); ++t) {
+    auto& tri = sm.triangles[t];
+    for (int k = 0; k < 3; ++k) {
+      if (tri[static_cast<std::size_t>(k)] != a || tri[static_cast<std::size_t>((k + 1) % 3)] != b)
+        continue;
+      const int c = tri[static_cast<std::size_t>((k + 2) % 3)];
+      const int face = sm.regionOfTriangle[t];
+      tri = {a, v, c};
+      addTriangle(sm, v, b, c, face);
+      return;
+    }
+  }
+  throw std::logic_error("cutGeometricMesh: an outline edge without its triangle");
+}
+
+// thesis 3.3.3: the tear's start s_t, an S_G outline vertex or a new one on the outline edge
+// holding it (added to h and sm); -1 when `from` is not on the outline.
+int tearStartVertex(GeometricMesh& h, mesh::SheetMesh& sm, const Vec2& from, double tol) {
   int fromVertex = -1;
   for (std::size_t v = 0; v < h.vertices.size(); ++v)
     if (h.vertices[v].onBoundary && (h.vertices[v].pattern - from).norm() <= tol) {
@@ -247,38 +249,17 @@ std::optional<GeometricCutResult> cutGeometricMesh(GeometricMesh& g, const Vec2&
       sm.pattern.push_back(nv.pattern);
       sm.positions.push_back(nv.position);
       // Split the triangle holding the edge a -> b.
-      for (std::size_t t = 0; t < sm.triangles.size(); ++t) {
-        auto& tri = sm.triangles[t];
-        for (int k = 0; k < 3; ++k) {
-          if (tri[static_cast<std::size_t>(k)] != a ||
-              tri[static_cast<std::size_t>((k + 1) % 3)] != b)
-            continue;
-          const int c = tri[static_cast<std::size_t>((k + 2) % 3)];
-          const int face = sm.regionOfTriangle[t];
-          tri = {a, fromVertex, c};
-          addTriangle(fromVertex, b, c, face);
-          goto split;
-        }
-      }
-      throw std::logic_error("cutGeometricMesh: an outline edge without its triangle");
-    split:
+      splitOutlineTriangle(sm, a, b, fromVertex);
       break;
     }
   }
-  if (fromVertex < 0)
-    throw std::invalid_argument("cutGeometricMesh: the tear's start is not on S_G's outline");
+  return fromVertex;
+}
 
-  // The cut (thesis 3.3.3): existing S_G vertices never move.
-  const std::size_t before = h.vertices.size();
-  std::vector<char> fixed(before, 1);
-  tear::CutOptions cutOptions;
-  cutOptions.snap = options.snap;
-  cutOptions.fixed = &fixed;
-  const tear::CutResult cut = tear::cutAlong(sm, fromVertex, to, cutOptions);
-  if (cut.separated) return std::nullopt;
-  if (cut.chain.size() < 2) throw std::invalid_argument("cutGeometricMesh: the cut is empty");
-
-  // New vertices: the lips' copies and s_{t+1}, blended from the old ones.
+// thesis 3.3.3: the S_G vertices of the cut's new vertices of sm (from index `before` on),
+// blended from the old ones, placed on the surface when options.surface says where.
+void addCutVertices(GeometricMesh& h, const mesh::SheetMesh& sm, const tear::CutResult& cut,
+                    std::size_t before, const GeometricCutOptions& options) {
   for (std::size_t i = before; i < sm.vertexCount(); ++i) {
     const tear::VertexBlend& b = cut.blends.at(i - before);
     GeometricVertex nv;
@@ -297,7 +278,11 @@ std::optional<GeometricCutResult> cutGeometricMesh(GeometricMesh& g, const Vec2&
     }
     (void)addVertex(h, nv);
   }
-  // Faces in their old order: an unchanged face as it was, a cut one as its pieces.
+}
+
+// thesis 3.3.3 case 3 (Fig. 3.23): S_G's faces in their old order after the cut, an unchanged
+// face as it was, a cut one as its triangles.
+std::vector<GeometricFace> facesAfterCut(const GeometricMesh& h, const mesh::SheetMesh& sm) {
   std::vector<std::vector<std::array<int, 3>>> pieces(h.faces.size());
   for (std::size_t t = 0; t < sm.triangles.size(); ++t)
     pieces[static_cast<std::size_t>(sm.regionOfTriangle[t])].push_back(sm.triangles[t]);
@@ -323,21 +308,16 @@ std::optional<GeometricCutResult> cutGeometricMesh(GeometricMesh& g, const Vec2&
       faces.push_back(nf);
     }
   }
-  h.faces = std::move(faces);
+  return faces;
+}
 
-  // The kerf: each lip's copies move off the centre line by w / 2, to where
-  // the kerf lines of the cut's pieces on either side of them meet; a new
-  // tear's first copies slide along their outline edge instead. s_{t+1}
-  // stays: the slit is a V there.
-  std::vector<Vec2> centre;
-  for (int v : cut.chain) centre.push_back(sm.pattern[static_cast<std::size_t>(v)]);
-  result.cut = centre;
+// thesis 3.3.3 (the split s_t^1, s_t^2 of Fig. 3.20): each lip copy's move off the cut's
+// centre line for a kerf of width w; a new tear's first copies slide along their outline edge.
+std::vector<std::pair<int, Vec2>> kerfMoves(const GeometricMesh& h, const std::vector<Vec2>& centre,
+                                            const tear::CutResult& cut, double w,
+                                            const std::optional<Vec2>& previousDirection,
+                                            const std::vector<std::vector<int>>& trianglesOf) {
   const auto left = [](const Vec2& d) { return Vec2(-d.y(), d.x()); };
-  std::vector<std::vector<int>> trianglesOf(h.vertices.size());
-  for (std::size_t f = 0; f < h.faces.size(); ++f)
-    for (int k = 0; k < h.faces[f].size(); ++k)
-      trianglesOf[static_cast<std::size_t>(h.faces[f].v[static_cast<std::size_t>(k)])].push_back(
-          static_cast<int>(f));
   const std::map<int, int> next = boundaryNext(h);
   std::map<int, int> prev;
   for (const auto& [a, b] : next) prev[b] = a;
@@ -382,6 +362,74 @@ std::optional<GeometricCutResult> cutGeometricMesh(GeometricMesh& g, const Vec2&
       moves.emplace_back(c, move);
     }
   }
+  return moves;
+}
+
+}  // namespace
+
+// thesis 3.3.3 "Remeshing", Figs. 3.20-3.23.
+std::optional<GeometricCutResult> cutGeometricMesh(GeometricMesh& g, const Vec2& from,
+                                                   const Vec2& to,
+                                                   const GeometricCutOptions& options,
+                                                   const std::optional<Vec2>& previousDirection) {
+  if (!(options.kerf > 0.0) || !std::isfinite(options.kerf))
+    throw std::invalid_argument("cutGeometricMesh: kerf must be finite and > 0");
+  if (!from.allFinite() || !to.allFinite())
+    throw std::invalid_argument("cutGeometricMesh: non-finite advance");
+  if (previousDirection) {
+    const Vec2 d = to - from;
+    const double turn =
+        std::atan2(std::abs(cross2(*previousDirection, d)), previousDirection->dot(d));
+    if (turn > options.maxTurn)
+      throw std::invalid_argument("cutGeometricMesh: the tear would turn back by " +
+                                  std::to_string(turn * 180.0 / std::numbers::pi) + " degrees");
+  }
+  GeometricMesh h = g;
+  const double perimeter = outlinePerimeter(h);
+  const double tol = 1e-9 * perimeter;
+  const double w = options.kerf;
+  GeometricCutResult result;
+
+  // Cases 1-2 to case 3: the curved regions the advance touches become flat.
+  result.regionsFlattened = flattenTouchedRegions(h, from, to, tol);
+
+  // S_G's faces as a triangle mesh; each triangle's region is its S_G face.
+  mesh::SheetMesh sm = triangleMesh(h);
+
+  // s_t: an S_G outline vertex, or a new one on the outline edge holding it.
+  const int fromVertex = tearStartVertex(h, sm, from, tol);
+  if (fromVertex < 0)
+    throw std::invalid_argument("cutGeometricMesh: the tear's start is not on S_G's outline");
+
+  // The cut (thesis 3.3.3): existing S_G vertices never move.
+  const std::size_t before = h.vertices.size();
+  std::vector<char> fixed(before, 1);
+  tear::CutOptions cutOptions;
+  cutOptions.snap = options.snap;
+  cutOptions.fixed = &fixed;
+  const tear::CutResult cut = tear::cutAlong(sm, fromVertex, to, cutOptions);
+  if (cut.separated) return std::nullopt;
+  if (cut.chain.size() < 2) throw std::invalid_argument("cutGeometricMesh: the cut is empty");
+
+  // New vertices: the lips' copies and s_{t+1}, blended from the old ones.
+  addCutVertices(h, sm, cut, before, options);
+  // Faces in their old order: an unchanged face as it was, a cut one as its pieces.
+  h.faces = facesAfterCut(h, sm);
+
+  // The kerf: each lip's copies move off the centre line by w / 2, to where
+  // the kerf lines of the cut's pieces on either side of them meet; a new
+  // tear's first copies slide along their outline edge instead. s_{t+1}
+  // stays: the slit is a V there.
+  std::vector<Vec2> centre;
+  for (int v : cut.chain) centre.push_back(sm.pattern[static_cast<std::size_t>(v)]);
+  result.cut = centre;
+  std::vector<std::vector<int>> trianglesOf(h.vertices.size());
+  for (std::size_t f = 0; f < h.faces.size(); ++f)
+    for (int k = 0; k < h.faces[f].size(); ++k)
+      trianglesOf[static_cast<std::size_t>(h.faces[f].v[static_cast<std::size_t>(k)])].push_back(
+          static_cast<int>(f));
+  const std::vector<std::pair<int, Vec2>> moves =
+      kerfMoves(h, centre, cut, w, previousDirection, trianglesOf);
   for (const auto& [c, move] : moves) h.vertices[static_cast<std::size_t>(c)].pattern += move;
   for (const auto& [c, move] : moves)
     for (int f : trianglesOf[static_cast<std::size_t>(c)])

@@ -448,6 +448,268 @@ using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
+
+// The curvature grid over the pattern (thesis 4.3.2, Fig. 4.10): its step, first point and size.
+struct GridGeometry {
+  double step = 0.0;
+  Vec2 origin = Vec2::Zero();
+  int nx = 0, ny = 0;
+};
+
+// thesis 4.3.2, Fig. 4.10: the shot's grid over the pattern's bounds, centred, at the step
+// asked for or larger for a big sheet.
+GridGeometry shotGrid(const mesh::SheetMesh& m, const EventParams& params) {
+  GridGeometry grid;
+  Vec2 lo = m.pattern.front(), hi = lo;
+  for (const Vec2& p : m.pattern) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const Vec2 size = hi - lo;
+  grid.step = std::max(params.gridSpacing,
+                       std::sqrt(std::max(size.x() * size.y(), 0.0) / params.maxGridPoints));
+  grid.nx = static_cast<int>(std::floor(size.x() / grid.step)) + 1;
+  grid.ny = static_cast<int>(std::floor(size.y() / grid.step)) + 1;
+  grid.origin = lo + 0.5 * (size - Vec2((grid.nx - 1) * grid.step, (grid.ny - 1) * grid.step));
+  return grid;
+}
+
+// The sheet at each grid point: its surface point and triangle (-1: off the sheet).
+struct GridSamples {
+  std::vector<std::optional<Vec3>> point;
+  std::vector<int> triangleAt;
+};
+
+// thesis 4.3.2: the surface point of every grid point, located in the pattern.
+GridSamples sampleGrid(const mesh::SheetMesh& m, const PatternLocator& locator,
+                       const GridGeometry& grid) {
+  const std::size_t n = static_cast<std::size_t>(grid.nx * grid.ny);
+  GridSamples samples;
+  samples.point.resize(n);
+  samples.triangleAt.assign(n, -1);
+  for (int j = 0; j < grid.ny; ++j)
+    for (int i = 0; i < grid.nx; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j * grid.nx + i);
+      if (const auto hit = locator.locate(grid.origin + grid.step * Vec2(i, j))) {
+        samples.point[k] = surfacePoint(m, *hit);
+        samples.triangleAt[k] = hit->triangle;
+      }
+    }
+  return samples;
+}
+
+// thesis 4.3.2: the mean curvature H = (Laplacian . n) / 2 at each grid point by central
+// differences; undefined where a neighbour is off the sheet or across an opened tear.
+std::vector<std::optional<double>> gridCurvature(const std::vector<std::optional<Vec3>>& point,
+                                                 const GridGeometry& grid) {
+  const int nx = grid.nx, ny = grid.ny;
+  std::vector<std::optional<double>> now(point.size());
+  const double h2 = grid.step * grid.step;
+  for (int j = 1; j + 1 < ny; ++j)
+    for (int i = 1; i + 1 < nx; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j * nx + i);
+      const auto& e = point[k + 1];
+      const auto& w = point[k - 1];
+      const auto& nn = point[k + static_cast<std::size_t>(nx)];
+      const auto& s = point[k - static_cast<std::size_t>(nx)];
+      if (!point[k] || !e || !w || !nn || !s) continue;
+      const Vec3& p = *point[k];
+      const double reach = 2.0 * grid.step;
+      if ((*e - p).norm() > reach || (*w - p).norm() > reach || (*nn - p).norm() > reach ||
+          (*s - p).norm() > reach)
+        continue;
+      const Vec3 normal = (*e - *w).cross(*nn - *s);
+      if (normal.norm() == 0.0) continue;
+      const Vec3 laplacian = (*e + *w + *nn + *s - 4.0 * p) / h2;
+      now[k] = 0.5 * laplacian.dot(normal.normalized());
+    }
+  return now;
+}
+
+// A frame's Topology, built the first time an event needs it.
+class LazyTopology {
+ public:
+  LazyTopology(const SheetFrame& frame, const EventParams& params)
+      : frame_(frame), params_(params) {}
+  const Topology& get() {
+    if (!topology_) topology_ = buildTopology(frame_, params_);
+    return *topology_;
+  }
+
+ private:
+  const SheetFrame& frame_;
+  const EventParams& params_;
+  std::optional<Topology> topology_;
+};
+
+// What the event searches of one frame share: its resonators' inputs and where events go.
+struct EventSearch {
+  const SheetFrame& frame;
+  const EventParams& params;
+  const std::vector<char>& blocked;  // held and touching vertices
+  LazyTopology& topology;
+  double& resonatorMs;  // time spent growing resonators
+  std::vector<SoundEvent>& events;
+};
+
+// thesis 4.3.2 "Event Detection": crumpling events, the 4-connected patches of grid points
+// whose curvature changed sign the same way by more than the threshold, with their resonators.
+void crumplingEvents(EventSearch& out, const GridGeometry& grid, const GridSamples& samples,
+                     const std::vector<std::optional<double>>& now,
+                     const std::vector<std::optional<double>>& previous) {
+  const std::vector<std::optional<Vec3>>& point = samples.point;
+  const std::vector<int>& triangleAt = samples.triangleAt;
+  const int nx = grid.nx, ny = grid.ny;
+  const std::size_t n = now.size();
+  const double h2 = grid.step * grid.step;
+  std::vector<int> flag(n, 0);  // +1: became positive, -1: became negative
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!now[k] || !previous[k]) continue;
+    const double a = *previous[k], b = *now[k];
+    if (a * b < 0.0 && std::abs(b - a) > out.params.curvatureThreshold) flag[k] = b > 0.0 ? 1 : -1;
+  }
+  std::vector<char> seen(n, 0);
+  for (std::size_t start = 0; start < n; ++start) {
+    if (flag[start] == 0 || seen[start]) continue;
+    SoundEvent ev;
+    ev.kind = EventKind::Crumpling;
+    std::vector<int> seeds;
+    std::vector<std::size_t> stack{start};
+    seen[start] = 1;
+    int count = 0;
+    while (!stack.empty()) {
+      const std::size_t k = stack.back();
+      stack.pop_back();
+      ev.amplitude += std::abs(*now[k] - *previous[k]) * h2;
+      ev.position += *point[k];
+      ++count;
+      seeds.push_back(triangleAt[k]);
+      const int i = static_cast<int>(k) % nx, j = static_cast<int>(k) / nx;
+      const std::pair<int, int> around[] = {{i + 1, j}, {i - 1, j}, {i, j + 1}, {i, j - 1}};
+      for (const auto& [a, b] : around) {
+        if (a < 0 || b < 0 || a >= nx || b >= ny) continue;
+        const std::size_t q = static_cast<std::size_t>(b * nx + a);
+        if (seen[q] || flag[q] != flag[start]) continue;
+        seen[q] = 1;
+        stack.push_back(q);
+      }
+    }
+    ev.position /= count;
+    std::sort(seeds.begin(), seeds.end());
+    seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+    ev.normal = out.topology.get().normals[static_cast<std::size_t>(seeds.front())];
+    const auto grow = Clock::now();
+    ev.resonators =
+        growResonators(out.frame, out.topology.get(), seeds, out.blocked, out.blocked, out.params);
+    out.resonatorMs += msSince(grow);
+    out.events.push_back(std::move(ev));
+  }
+}
+
+// thesis 4.3.2 "Event Detection": friction events, the touching vertices connected by the
+// mesh's edges, at their mean sliding speed, each with its resonators.
+void frictionEvents(EventSearch& out) {
+  const SheetFrame& frame = out.frame;
+  const mesh::SheetMesh& m = *frame.mesh;
+  std::vector<double> speed(m.vertexCount(), -1.0);
+  for (const auto& c : frame.contacts)
+    speed[static_cast<std::size_t>(c.vertex)] =
+        std::max(speed[static_cast<std::size_t>(c.vertex)], c.slideSpeed);
+  const Topology& t = out.topology.get();
+  std::vector<std::vector<int>> neighbours(m.vertexCount());
+  for (const auto& e : t.edges)
+    if (speed[static_cast<std::size_t>(e.v[0])] >= 0.0 &&
+        speed[static_cast<std::size_t>(e.v[1])] >= 0.0) {
+      neighbours[static_cast<std::size_t>(e.v[0])].push_back(e.v[1]);
+      neighbours[static_cast<std::size_t>(e.v[1])].push_back(e.v[0]);
+    }
+  std::vector<std::vector<int>> trianglesAt(m.vertexCount());
+  for (std::size_t i = 0; i < m.triangles.size(); ++i)
+    for (int v : m.triangles[i])
+      if (speed[static_cast<std::size_t>(v)] >= 0.0)
+        trianglesAt[static_cast<std::size_t>(v)].push_back(static_cast<int>(i));
+  std::vector<char> held(m.vertexCount(), 0);
+  for (int v : frame.heldVertices) held[static_cast<std::size_t>(v)] = 1;
+  std::vector<char> done(m.vertexCount(), 0);
+  for (std::size_t v0 = 0; v0 < m.vertexCount(); ++v0) {
+    if (speed[v0] < 0.0 || done[v0]) continue;
+    std::vector<int> component, stack{static_cast<int>(v0)};
+    done[v0] = 1;
+    while (!stack.empty()) {
+      const int v = stack.back();
+      stack.pop_back();
+      component.push_back(v);
+      for (int w : neighbours[static_cast<std::size_t>(v)])
+        if (!done[static_cast<std::size_t>(w)]) {
+          done[static_cast<std::size_t>(w)] = 1;
+          stack.push_back(w);
+        }
+    }
+    SoundEvent ev;
+    ev.kind = EventKind::Friction;
+    std::vector<int> seeds;
+    for (int v : component) {
+      ev.amplitude += speed[static_cast<std::size_t>(v)];
+      ev.position += m.positions[static_cast<std::size_t>(v)];
+      seeds.insert(seeds.end(), trianglesAt[static_cast<std::size_t>(v)].begin(),
+                   trianglesAt[static_cast<std::size_t>(v)].end());
+    }
+    ev.amplitude /= static_cast<double>(component.size());
+    ev.position /= static_cast<double>(component.size());
+    if (ev.amplitude < out.params.minSlideSpeed || seeds.empty()) continue;
+    std::sort(seeds.begin(), seeds.end());
+    seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+    ev.normal = t.normals[static_cast<std::size_t>(seeds.front())];
+    const auto grow = Clock::now();
+    // The vibration starts where the sheet rubs and spreads from there:
+    // the held points and the ridges stop it, the contacts do not (the
+    // rubbing ones are its source, and a coarse mesh touches a table at
+    // scattered vertices that would otherwise wall every patch in).
+    ev.resonators = growResonators(frame, t, seeds, held, out.blocked, out.params);
+    out.resonatorMs += msSince(grow);
+    out.events.push_back(std::move(ev));
+  }
+}
+
+// thesis 4.4: tearing events, each tear whose tip advanced, at its advance's length over the
+// time since its previous advance (lastAdvance: tear -> that time).
+void tearingEvents(EventSearch& out, const PatternLocator& locator,
+                   std::map<int, double>& lastAdvance) {
+  const SheetFrame& frame = out.frame;
+  const mesh::SheetMesh& m = *frame.mesh;
+  std::map<int, std::pair<double, Vec2>> tips;  // tear -> (length, last tip)
+  for (const auto& a : frame.tearAdvances) {
+    auto& [length, tip] = tips[a.tear];
+    length += (a.to - a.from).norm();
+    tip = a.to;
+  }
+  for (const auto& [tear, advance] : tips) {
+    SoundEvent ev;
+    ev.kind = EventKind::Tearing;
+    ev.tear = tear;
+    const auto last = lastAdvance.find(tear);
+    ev.duration = last == lastAdvance.end()
+                      ? frame.frameDuration
+                      : std::clamp(frame.time - last->second, frame.frameDuration,
+                                   std::max(frame.frameDuration, out.params.maxTearGap));
+    lastAdvance[tear] = frame.time;
+    ev.amplitude = advance.first / ev.duration;
+    if (const auto hit = locator.locate(advance.second)) {
+      ev.position = surfacePoint(m, *hit);
+      ev.normal = out.topology.get().normals[static_cast<std::size_t>(hit->triangle)];
+    } else {
+      // The tip on the outline, a hair outside every triangle: its nearest vertex.
+      std::size_t best = 0;
+      for (std::size_t v = 1; v < m.vertexCount(); ++v)
+        if ((m.pattern[v] - advance.second).squaredNorm() <
+            (m.pattern[best] - advance.second).squaredNorm())
+          best = v;
+      ev.position = m.positions[best];
+    }
+    out.events.push_back(std::move(ev));
+  }
+}
+
 }  // namespace
 
 std::vector<SoundEvent> EventDetector::detect(const SheetFrame& frame) {
@@ -465,201 +727,35 @@ std::vector<SoundEvent> EventDetector::detect(const SheetFrame& frame) {
   if (nx_ == 0) {
     // The grid (Fig. 4.10), fixed for the shot: over the pattern's bounds,
     // centred, at the step asked for or larger for a big sheet.
-    Vec2 lo = m.pattern.front(), hi = lo;
-    for (const Vec2& p : m.pattern) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-    const Vec2 size = hi - lo;
-    step_ = std::max(params_.gridSpacing,
-                     std::sqrt(std::max(size.x() * size.y(), 0.0) / params_.maxGridPoints));
-    nx_ = static_cast<int>(std::floor(size.x() / step_)) + 1;
-    ny_ = static_cast<int>(std::floor(size.y() / step_)) + 1;
-    origin_ = lo + 0.5 * (size - Vec2((nx_ - 1) * step_, (ny_ - 1) * step_));
+    const GridGeometry grid = shotGrid(m, params_);
+    step_ = grid.step;
+    nx_ = grid.nx;
+    ny_ = grid.ny;
+    origin_ = grid.origin;
     previous_.assign(static_cast<std::size_t>(nx_ * ny_), std::nullopt);
   }
-  const std::size_t n = static_cast<std::size_t>(nx_ * ny_);
-  std::vector<std::optional<Vec3>> point(n);
-  std::vector<int> triangleAt(n, -1);
-  for (int j = 0; j < ny_; ++j)
-    for (int i = 0; i < nx_; ++i) {
-      const std::size_t k = static_cast<std::size_t>(j * nx_ + i);
-      if (const auto hit = locator.locate(origin_ + step_ * Vec2(i, j))) {
-        point[k] = surfacePoint(m, *hit);
-        triangleAt[k] = hit->triangle;
-      }
-    }
+  const GridGeometry grid{step_, origin_, nx_, ny_};
+  const GridSamples samples = sampleGrid(m, locator, grid);
   // H = (Laplacian . n) / 2 by central differences over the grid's four
   // neighbours (the pattern is the surface's isometric chart); undefined
   // where a neighbour is off the sheet or across an opened tear.
-  std::vector<std::optional<double>> now(n);
-  const double h2 = step_ * step_;
-  for (int j = 1; j + 1 < ny_; ++j)
-    for (int i = 1; i + 1 < nx_; ++i) {
-      const std::size_t k = static_cast<std::size_t>(j * nx_ + i);
-      const auto& e = point[k + 1];
-      const auto& w = point[k - 1];
-      const auto& nn = point[k + static_cast<std::size_t>(nx_)];
-      const auto& s = point[k - static_cast<std::size_t>(nx_)];
-      if (!point[k] || !e || !w || !nn || !s) continue;
-      const Vec3& p = *point[k];
-      const double reach = 2.0 * step_;
-      if ((*e - p).norm() > reach || (*w - p).norm() > reach || (*nn - p).norm() > reach ||
-          (*s - p).norm() > reach)
-        continue;
-      const Vec3 normal = (*e - *w).cross(*nn - *s);
-      if (normal.norm() == 0.0) continue;
-      const Vec3 laplacian = (*e + *w + *nn + *s - 4.0 * p) / h2;
-      now[k] = 0.5 * laplacian.dot(normal.normalized());
-    }
+  std::vector<std::optional<double>> now = gridCurvature(samples.point, grid);
 
   // Crumpling events: 4-connected patches whose curvature changed sign the
   // same way by more than the threshold; amplitude the sum of the changes.
-  std::vector<int> flag(n, 0);  // +1: became positive, -1: became negative
-  for (std::size_t k = 0; k < n; ++k) {
-    if (!now[k] || !previous_[k]) continue;
-    const double a = *previous_[k], b = *now[k];
-    if (a * b < 0.0 && std::abs(b - a) > params_.curvatureThreshold) flag[k] = b > 0.0 ? 1 : -1;
-  }
   const std::vector<char> blocked = blockedVertices(frame);
-  std::optional<Topology> topology;
-  const auto topo = [&]() -> const Topology& {
-    if (!topology) topology = buildTopology(frame, params_);
-    return *topology;
-  };
-  std::vector<char> seen(n, 0);
-  for (std::size_t start = 0; start < n; ++start) {
-    if (flag[start] == 0 || seen[start]) continue;
-    SoundEvent ev;
-    ev.kind = EventKind::Crumpling;
-    std::vector<int> seeds;
-    std::vector<std::size_t> stack{start};
-    seen[start] = 1;
-    int count = 0;
-    while (!stack.empty()) {
-      const std::size_t k = stack.back();
-      stack.pop_back();
-      ev.amplitude += std::abs(*now[k] - *previous_[k]) * h2;
-      ev.position += *point[k];
-      ++count;
-      seeds.push_back(triangleAt[k]);
-      const int i = static_cast<int>(k) % nx_, j = static_cast<int>(k) / nx_;
-      const std::pair<int, int> around[] = {{i + 1, j}, {i - 1, j}, {i, j + 1}, {i, j - 1}};
-      for (const auto& [a, b] : around) {
-        if (a < 0 || b < 0 || a >= nx_ || b >= ny_) continue;
-        const std::size_t q = static_cast<std::size_t>(b * nx_ + a);
-        if (seen[q] || flag[q] != flag[start]) continue;
-        seen[q] = 1;
-        stack.push_back(q);
-      }
-    }
-    ev.position /= count;
-    std::sort(seeds.begin(), seeds.end());
-    seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
-    ev.normal = topo().normals[static_cast<std::size_t>(seeds.front())];
-    const auto grow = Clock::now();
-    ev.resonators = growResonators(frame, topo(), seeds, blocked, blocked, params_);
-    resonatorMs_ += msSince(grow);
-    events.push_back(std::move(ev));
-  }
+  LazyTopology topology(frame, params_);
+  EventSearch out{frame, params_, blocked, topology, resonatorMs_, events};
+  crumplingEvents(out, grid, samples, now, previous_);
   previous_ = std::move(now);
 
   // Friction events: the touching vertices, connected by the mesh's edges;
   // amplitude their mean sliding speed.
-  if (!frame.contacts.empty()) {
-    std::vector<double> speed(m.vertexCount(), -1.0);
-    for (const auto& c : frame.contacts)
-      speed[static_cast<std::size_t>(c.vertex)] =
-          std::max(speed[static_cast<std::size_t>(c.vertex)], c.slideSpeed);
-    const Topology& t = topo();
-    std::vector<std::vector<int>> neighbours(m.vertexCount());
-    for (const auto& e : t.edges)
-      if (speed[static_cast<std::size_t>(e.v[0])] >= 0.0 &&
-          speed[static_cast<std::size_t>(e.v[1])] >= 0.0) {
-        neighbours[static_cast<std::size_t>(e.v[0])].push_back(e.v[1]);
-        neighbours[static_cast<std::size_t>(e.v[1])].push_back(e.v[0]);
-      }
-    std::vector<std::vector<int>> trianglesAt(m.vertexCount());
-    for (std::size_t i = 0; i < m.triangles.size(); ++i)
-      for (int v : m.triangles[i])
-        if (speed[static_cast<std::size_t>(v)] >= 0.0)
-          trianglesAt[static_cast<std::size_t>(v)].push_back(static_cast<int>(i));
-    std::vector<char> held(m.vertexCount(), 0);
-    for (int v : frame.heldVertices) held[static_cast<std::size_t>(v)] = 1;
-    std::vector<char> done(m.vertexCount(), 0);
-    for (std::size_t v0 = 0; v0 < m.vertexCount(); ++v0) {
-      if (speed[v0] < 0.0 || done[v0]) continue;
-      std::vector<int> component, stack{static_cast<int>(v0)};
-      done[v0] = 1;
-      while (!stack.empty()) {
-        const int v = stack.back();
-        stack.pop_back();
-        component.push_back(v);
-        for (int w : neighbours[static_cast<std::size_t>(v)])
-          if (!done[static_cast<std::size_t>(w)]) {
-            done[static_cast<std::size_t>(w)] = 1;
-            stack.push_back(w);
-          }
-      }
-      SoundEvent ev;
-      ev.kind = EventKind::Friction;
-      std::vector<int> seeds;
-      for (int v : component) {
-        ev.amplitude += speed[static_cast<std::size_t>(v)];
-        ev.position += m.positions[static_cast<std::size_t>(v)];
-        seeds.insert(seeds.end(), trianglesAt[static_cast<std::size_t>(v)].begin(),
-                     trianglesAt[static_cast<std::size_t>(v)].end());
-      }
-      ev.amplitude /= static_cast<double>(component.size());
-      ev.position /= static_cast<double>(component.size());
-      if (ev.amplitude < params_.minSlideSpeed || seeds.empty()) continue;
-      std::sort(seeds.begin(), seeds.end());
-      seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
-      ev.normal = t.normals[static_cast<std::size_t>(seeds.front())];
-      const auto grow = Clock::now();
-      // The vibration starts where the sheet rubs and spreads from there:
-      // the held points and the ridges stop it, the contacts do not (the
-      // rubbing ones are its source, and a coarse mesh touches a table at
-      // scattered vertices that would otherwise wall every patch in).
-      ev.resonators = growResonators(frame, t, seeds, held, blocked, params_);
-      resonatorMs_ += msSince(grow);
-      events.push_back(std::move(ev));
-    }
-  }
+  if (!frame.contacts.empty()) frictionEvents(out);
 
   // Tearing events (thesis 4.4): each tear whose tip advanced, at its
   // advance's length over the time since its previous advance.
-  std::map<int, std::pair<double, Vec2>> tips;  // tear -> (length, last tip)
-  for (const auto& a : frame.tearAdvances) {
-    auto& [length, tip] = tips[a.tear];
-    length += (a.to - a.from).norm();
-    tip = a.to;
-  }
-  for (const auto& [tear, advance] : tips) {
-    SoundEvent ev;
-    ev.kind = EventKind::Tearing;
-    ev.tear = tear;
-    const auto last = lastAdvance_.find(tear);
-    ev.duration = last == lastAdvance_.end()
-                      ? frame.frameDuration
-                      : std::clamp(frame.time - last->second, frame.frameDuration,
-                                   std::max(frame.frameDuration, params_.maxTearGap));
-    lastAdvance_[tear] = frame.time;
-    ev.amplitude = advance.first / ev.duration;
-    if (const auto hit = locator.locate(advance.second)) {
-      ev.position = surfacePoint(m, *hit);
-      ev.normal = topo().normals[static_cast<std::size_t>(hit->triangle)];
-    } else {
-      // The tip on the outline, a hair outside every triangle: its nearest vertex.
-      std::size_t best = 0;
-      for (std::size_t v = 1; v < m.vertexCount(); ++v)
-        if ((m.pattern[v] - advance.second).squaredNorm() <
-            (m.pattern[best] - advance.second).squaredNorm())
-          best = v;
-      ev.position = m.positions[best];
-    }
-    events.push_back(std::move(ev));
-  }
+  tearingEvents(out, locator, lastAdvance_);
   return events;
 }
 

@@ -55,26 +55,30 @@ double peakLevel(const Audio& audio) {
   return peak;
 }
 
-Audio renderSoundtrack(const SoundDatabase& db, const Timeline& timeline,
-                       const std::vector<FrameEvents>& frames, const SoundtrackSettings& s,
-                       SoundtrackStats* statsOut) {
-  if (db.sampleRate() != timeline.sampleRate())
-    throw std::invalid_argument("renderSoundtrack: the database is at " +
-                                std::to_string(db.sampleRate()) + " Hz, the soundtrack at " +
-                                std::to_string(timeline.sampleRate()));
-  if (s.channels != 1 && s.channels != 2)
-    throw std::invalid_argument("renderSoundtrack: 1 or 2 channels, not " +
-                                std::to_string(s.channels));
-  SoundtrackStats stats;
-  const std::int64_t length = timeline.sampleCount();
-  const std::size_t frameCount =
-      std::min(frames.size(), static_cast<std::size_t>(timeline.frameCount()));
-  Audio audio;
-  audio.sampleRate = timeline.sampleRate();
-  audio.channels.assign(static_cast<std::size_t>(s.channels), {});
+namespace {
 
-  // Crumpling (4.3.3): each resonator's clip at the frame's sample, its
-  // variant drawn per resonator (the same for both ears).
+// What the parts of a soundtrack share: the inputs, the frames with events and the output.
+struct SoundtrackRender {
+  const SoundDatabase& db;
+  const Timeline& timeline;
+  const std::vector<FrameEvents>& frames;
+  const SoundtrackSettings& s;
+  std::size_t frameCount;  // frames with events within the timeline
+  std::int64_t length;     // samples
+  Audio& audio;
+  SoundtrackStats& stats;
+};
+
+// thesis 4.3.3: each crumpling resonator's clip at its frame's sample, its variant drawn per
+// resonator (the same for both ears).
+void addCrumplingClips(SoundtrackRender& render) {
+  const SoundDatabase& db = render.db;
+  const Timeline& timeline = render.timeline;
+  const std::vector<FrameEvents>& frames = render.frames;
+  const SoundtrackSettings& s = render.s;
+  const std::size_t frameCount = render.frameCount;
+  Audio& audio = render.audio;
+  SoundtrackStats& stats = render.stats;
   std::int64_t clipId = 0;
   for (std::size_t f = 0; f < frameCount; ++f) {
     const std::vector<Vec3> ears = earsOf(frames[f], s);
@@ -98,16 +102,22 @@ Audio renderSoundtrack(const SoundDatabase& db, const Timeline& timeline,
       }
     }
   }
+}
 
-  // Friction (Algorithm 4): per frame and ear, the resonators' spectra
-  // weighted by their event's speed and area share and by the dipole's
-  // eq. (4.12) factor, summed; each noise block sounds the spectrum of its
-  // centre's time, interpolated between frames.
+// thesis Algorithm 4, eq. (4.12): per frame and ear, the friction resonators' spectra weighted
+// by their event's speed and area share and by the dipole's factor, summed (empty: silent).
+std::vector<std::vector<std::vector<float>>> frictionSpectra(SoundtrackRender& render,
+                                                             bool& anyFriction) {
+  const SoundDatabase& db = render.db;
+  const Timeline& timeline = render.timeline;
+  const std::vector<FrameEvents>& frames = render.frames;
+  const SoundtrackSettings& s = render.s;
+  const std::size_t frameCount = render.frameCount;
+  SoundtrackStats& stats = render.stats;
   const int m = db.fftSize();
   const std::size_t bins = static_cast<std::size_t>(m / 2 + 1);
   std::vector<std::vector<std::vector<float>>> spectra(
       frameCount, std::vector<std::vector<float>>(static_cast<std::size_t>(s.channels)));
-  bool anyFriction = false;
   for (std::size_t f = 0; f < frameCount; ++f) {
     const std::vector<Vec3> ears = earsOf(frames[f], s);
     std::int64_t resonatorIndex = 0;
@@ -137,49 +147,69 @@ Audio renderSoundtrack(const SoundDatabase& db, const Timeline& timeline,
       }
     }
   }
-  if (anyFriction) {
-    const std::int64_t hop = m / 2;
-    // Blocks start one hop before the first sample, so that every sample
-    // lies under two windows.
-    const std::int64_t blocks = (length + hop) / hop + 1;
-    std::vector<float> power(bins);
-    for (std::size_t c = 0; c < static_cast<std::size_t>(s.channels); ++c) {
-      FrictionSynth synth(m, s.seed);
-      std::vector<float> out;
-      for (std::int64_t b = 0; b < blocks; ++b) {
-        const double centre = timeline.timeOf(b * hop - hop + m / 2);
-        const double at =
-            std::clamp(centre * timeline.fps(), 0.0, static_cast<double>(frameCount - 1));
-        const std::size_t f0 = static_cast<std::size_t>(std::floor(at));
-        const std::size_t f1 = std::min(f0 + 1, frameCount - 1);
-        const double w = at - static_cast<double>(f0);
-        const auto& p0 = spectra[f0][c];
-        const auto& p1 = spectra[f1][c];
-        if (p0.empty() && p1.empty()) continue;
-        bool silent = true;
-        for (std::size_t k = 0; k < bins; ++k) {
-          power[k] = static_cast<float>((p0.empty() ? 0.0 : (1.0 - w) * p0[k]) +
-                                        (p1.empty() ? 0.0 : w * p1[k]));
-          silent = silent && power[k] == 0.0f;
-        }
-        if (silent) continue;
-        synth.addBlock(b, power, out);
-        ++stats.frictionBlocks;
-      }
-      auto& channel = audio.channels[c];
-      channel.resize(std::max(channel.size(), out.size() > static_cast<std::size_t>(hop)
-                                                  ? out.size() - static_cast<std::size_t>(hop)
-                                                  : 0),
-                     0.0f);
-      for (std::size_t i = static_cast<std::size_t>(hop); i < out.size(); ++i)
-        channel[i - static_cast<std::size_t>(hop)] += out[i];
-    }
-  }
+  return spectra;
+}
 
-  // Tearing (4.4.1): each tear's crackle at its tip's speed over the time
-  // each advance took (SoundEvent::duration, ending at its frame), its
-  // edges ramped over kTearRamp; spatialised frame by frame as a small disk
-  // at the tip.
+// thesis 4.3.3 (friction by inverse FFT): each channel's friction noise, each block sounding
+// the spectrum of its centre's time interpolated between frames.
+void synthesizeFriction(SoundtrackRender& render,
+                        const std::vector<std::vector<std::vector<float>>>& spectra) {
+  const Timeline& timeline = render.timeline;
+  const SoundtrackSettings& s = render.s;
+  const std::size_t frameCount = render.frameCount;
+  const std::int64_t length = render.length;
+  Audio& audio = render.audio;
+  SoundtrackStats& stats = render.stats;
+  const int m = render.db.fftSize();
+  const std::size_t bins = static_cast<std::size_t>(m / 2 + 1);
+  const std::int64_t hop = m / 2;
+  // Blocks start one hop before the first sample, so that every sample
+  // lies under two windows.
+  const std::int64_t blocks = (length + hop) / hop + 1;
+  std::vector<float> power(bins);
+  for (std::size_t c = 0; c < static_cast<std::size_t>(s.channels); ++c) {
+    FrictionSynth synth(m, s.seed);
+    std::vector<float> out;
+    for (std::int64_t b = 0; b < blocks; ++b) {
+      const double centre = timeline.timeOf(b * hop - hop + m / 2);
+      const double at =
+          std::clamp(centre * timeline.fps(), 0.0, static_cast<double>(frameCount - 1));
+      const std::size_t f0 = static_cast<std::size_t>(std::floor(at));
+      const std::size_t f1 = std::min(f0 + 1, frameCount - 1);
+      const double w = at - static_cast<double>(f0);
+      const auto& p0 = spectra[f0][c];
+      const auto& p1 = spectra[f1][c];
+      if (p0.empty() && p1.empty()) continue;
+      bool silent = true;
+      for (std::size_t k = 0; k < bins; ++k) {
+        power[k] = static_cast<float>((p0.empty() ? 0.0 : (1.0 - w) * p0[k]) +
+                                      (p1.empty() ? 0.0 : w * p1[k]));
+        silent = silent && power[k] == 0.0f;
+      }
+      if (silent) continue;
+      synth.addBlock(b, power, out);
+      ++stats.frictionBlocks;
+    }
+    auto& channel = audio.channels[c];
+    channel.resize(std::max(channel.size(), out.size() > static_cast<std::size_t>(hop)
+                                                ? out.size() - static_cast<std::size_t>(hop)
+                                                : 0),
+                   0.0f);
+    for (std::size_t i = static_cast<std::size_t>(hop); i < out.size(); ++i)
+      channel[i - static_cast<std::size_t>(hop)] += out[i];
+  }
+}
+
+// thesis 4.4.1: each tear's crackle at its tip's speed over the time each advance took, its
+// edges ramped, spatialised frame by frame as a small disk at the tip.
+void addTearingNoise(SoundtrackRender& render) {
+  const Timeline& timeline = render.timeline;
+  const std::vector<FrameEvents>& frames = render.frames;
+  const SoundtrackSettings& s = render.s;
+  const std::size_t frameCount = render.frameCount;
+  const std::int64_t length = render.length;
+  Audio& audio = render.audio;
+  SoundtrackStats& stats = render.stats;
   std::map<int, std::vector<std::pair<std::size_t, const SoundEvent*>>> tears;
   for (std::size_t f = 0; f < frameCount; ++f)
     for (const auto& e : frames[f].events)
@@ -230,7 +260,46 @@ Audio renderSoundtrack(const SoundDatabase& db, const Timeline& timeline,
       }
     }
   }
+}
 
+}  // namespace
+
+Audio renderSoundtrack(const SoundDatabase& db, const Timeline& timeline,
+                       const std::vector<FrameEvents>& frames, const SoundtrackSettings& s,
+                       SoundtrackStats* statsOut) {
+  if (db.sampleRate() != timeline.sampleRate())
+    throw std::invalid_argument("renderSoundtrack: the database is at " +
+                                std::to_string(db.sampleRate()) + " Hz, the soundtrack at " +
+                                std::to_string(timeline.sampleRate()));
+  if (s.channels != 1 && s.channels != 2)
+    throw std::invalid_argument("renderSoundtrack: 1 or 2 channels, not " +
+                                std::to_string(s.channels));
+  SoundtrackStats stats;
+  const std::int64_t length = timeline.sampleCount();
+  const std::size_t frameCount =
+      std::min(frames.size(), static_cast<std::size_t>(timeline.frameCount()));
+  Audio audio;
+  audio.sampleRate = timeline.sampleRate();
+  audio.channels.assign(static_cast<std::size_t>(s.channels), {});
+
+  // Crumpling (4.3.3): each resonator's clip at the frame's sample, its
+  // variant drawn per resonator (the same for both ears).
+  SoundtrackRender render{db, timeline, frames, s, frameCount, length, audio, stats};
+  addCrumplingClips(render);
+
+  // Friction (Algorithm 4): per frame and ear, the resonators' spectra
+  // weighted by their event's speed and area share and by the dipole's
+  // eq. (4.12) factor, summed; each noise block sounds the spectrum of its
+  // centre's time, interpolated between frames.
+  bool anyFriction = false;
+  const std::vector<std::vector<std::vector<float>>> spectra = frictionSpectra(render, anyFriction);
+  if (anyFriction) synthesizeFriction(render, spectra);
+
+  // Tearing (4.4.1): each tear's crackle at its tip's speed over the time
+  // each advance took (SoundEvent::duration, ending at its frame), its
+  // edges ramped over kTearRamp; spatialised frame by frame as a small disk
+  // at the tip.
+  addTearingNoise(render);
   for (auto& channel : audio.channels) channel.resize(static_cast<std::size_t>(length), 0.0f);
   if (statsOut != nullptr) *statsOut = stats;
   return audio;

@@ -294,20 +294,26 @@ void pack(TearAtlas& atlas) {
   atlas.height = order.empty() ? 0 : y + shelf;
 }
 
-}  // namespace
+// The triangle's corners in the pattern.
+std::array<Vec2, 3> cornersOf(const mesh::SheetMesh& mesh, int t) {
+  const auto& tri = mesh.triangles[static_cast<std::size_t>(t)];
+  return std::array<Vec2, 3>{mesh.pattern[static_cast<std::size_t>(tri[0])],
+                             mesh.pattern[static_cast<std::size_t>(tri[1])],
+                             mesh.pattern[static_cast<std::size_t>(tri[2])]};
+}
 
-TearAtlas bakeTearAtlas(const mesh::SheetMesh& mesh, const std::vector<TearSegment>& segments,
-                        const TearAtlasParams& params) {
-  if (!(params.texelSize > 0.0) || !std::isfinite(params.texelSize))
-    throw std::invalid_argument("bakeTearAtlas: texel size must be finite and > 0");
-  if (!(params.margin >= 0.0) || !std::isfinite(params.margin))
-    throw std::invalid_argument("bakeTearAtlas: margin must be finite and >= 0");
+// The lengths of a bake: below tol points coincide, lipTol a lip's distance to its cut,
+// reach how far the padded paths run beyond the cut's ends.
+struct AtlasScale {
+  double tol = 0.0;
+  double lipTol = 0.0;
+  double reach = 0.0;
+};
+
+// The bake's lengths from the extent of the mesh's pattern and of the segments' paths.
+AtlasScale atlasScale(const mesh::SheetMesh& mesh, const std::vector<TearSegment>& segments,
+                      const TearAtlasParams& params) {
   const double texel = params.texelSize;
-  TearAtlas atlas;
-  atlas.texelSize = texel;
-
-  // Lengths below tol are coincident points (the cut's points are the
-  // mesh's pattern positions).
   Vec2 lo = Vec2::Constant(kInf), hi = -lo;
   for (const Vec2& p : mesh.pattern) {
     lo = lo.cwiseMin(p);
@@ -322,10 +328,21 @@ TearAtlas bakeTearAtlas(const mesh::SheetMesh& mesh, const std::vector<TearSegme
         }
   const double extent =
       lo.allFinite() ? std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff()) : 0.0;
+  AtlasScale scale;
   const double tol = 1e-9 * std::max(extent, 1e-3);
-  const double lipTol = std::max(tol, params.lipTolerance);
-  const double reach = 4.0 * (lo.allFinite() ? (hi - lo).norm() : 0.0) + 1e3 * texel;
+  scale.tol = tol;
+  scale.lipTol = std::max(tol, params.lipTolerance);
+  scale.reach = 4.0 * (lo.allFinite() ? (hi - lo).norm() : 0.0) + 1e3 * texel;
+  return scale;
+}
 
+// thesis 3.3.4: each tear's joined cut and detail path with their length, support width and
+// padded paths; tears that have not advanced dropped.
+std::vector<Chain> tearChains(const std::vector<TearSegment>& segments, const AtlasScale& scale,
+                              const TearAtlasParams& params) {
+  const double texel = params.texelSize;
+  const double tol = scale.tol;
+  const double reach = scale.reach;
   std::vector<Chain> chains = chainsOf(segments, tol, 0.5 * texel);
   std::erase_if(chains, [&](Chain& c) {
     c.cut = withoutRepeats(c.cut, tol);
@@ -347,53 +364,55 @@ TearAtlas bakeTearAtlas(const mesh::SheetMesh& mesh, const std::vector<TearSegme
     c.paddedCut = padded(c.cut, backward, forward, reach);
     c.paddedDetail = padded(c.detail, backward, forward, reach);
   }
+  return chains;
+}
 
-  // 1. Lip edges: boundary edges on a cut; the triangle's side is the cut's
-  // side its interior is on (counter-clockwise triangles: left of the edge
-  // walked from corner k to corner k + 1).
+// thesis 3.3.4: the lip triangles, with a boundary edge on a cut, and their side of it
+// (counter-clockwise triangles: left of the edge walked from corner k to corner k + 1).
+std::map<int, Bordering> lipTriangles(const mesh::SheetMesh& mesh, const std::vector<Chain>& chains,
+                                      const AtlasScale& scale) {
+  const double tol = scale.tol;
+  const double lipTol = scale.lipTol;
   std::map<int, Bordering> borders;
-  const auto corners = [&](int t) {
+  if (chains.empty()) return borders;
+  for (const mesh::MeshEdge& e : mesh::buildEdges(mesh)) {
+    if (e.interior()) continue;
+    const int t = e.triangles[0];
     const auto& tri = mesh.triangles[static_cast<std::size_t>(t)];
-    return std::array<Vec2, 3>{mesh.pattern[static_cast<std::size_t>(tri[0])],
-                               mesh.pattern[static_cast<std::size_t>(tri[1])],
-                               mesh.pattern[static_cast<std::size_t>(tri[2])]};
-  };
-  if (!chains.empty()) {
-    for (const mesh::MeshEdge& e : mesh::buildEdges(mesh)) {
-      if (e.interior()) continue;
-      const int t = e.triangles[0];
-      const auto& tri = mesh.triangles[static_cast<std::size_t>(t)];
-      int k = 0;
-      while (k < 3 && !((tri[static_cast<std::size_t>(k)] == e.v[0] ||
-                         tri[static_cast<std::size_t>(k)] == e.v[1]) &&
-                        (tri[static_cast<std::size_t>((k + 1) % 3)] == e.v[0] ||
-                         tri[static_cast<std::size_t>((k + 1) % 3)] == e.v[1])))
-        ++k;
-      const auto p = corners(t);
-      const Vec2& a = p[static_cast<std::size_t>(k)];
-      const Vec2& b = p[static_cast<std::size_t>((k + 1) % 3)];
-      for (std::size_t c = 0; c < chains.size(); ++c) {
-        const Closest ca = closestOnPolyline(chains[c].cut, a);
-        const Closest cb = closestOnPolyline(chains[c].cut, b);
-        if (ca.distance > lipTol || cb.distance > lipTol || std::abs(ca.param - cb.param) <= tol ||
-            closestOnPolyline(chains[c].cut, 0.5 * (a + b)).distance > lipTol)
-          continue;
-        Bordering& bd = borders[t];
-        const LipSide side = ca.param < cb.param ? LipSide::Left : LipSide::Right;
-        if (const LipSide* known = bd.sideOf(c); known == nullptr)
-          bd.sides.emplace_back(c, side);
-        else if (*known != side)
-          break;  // both sides of one cut: not a lip (cannot happen in a cut mesh)
-        bd.edgeChain[static_cast<std::size_t>(k)] = static_cast<int>(c);
-        break;
-      }
+    int k = 0;
+    while (k < 3 && !((tri[static_cast<std::size_t>(k)] == e.v[0] ||
+                       tri[static_cast<std::size_t>(k)] == e.v[1]) &&
+                      (tri[static_cast<std::size_t>((k + 1) % 3)] == e.v[0] ||
+                       tri[static_cast<std::size_t>((k + 1) % 3)] == e.v[1])))
+      ++k;
+    const auto p = cornersOf(mesh, t);
+    const Vec2& a = p[static_cast<std::size_t>(k)];
+    const Vec2& b = p[static_cast<std::size_t>((k + 1) % 3)];
+    for (std::size_t c = 0; c < chains.size(); ++c) {
+      const Closest ca = closestOnPolyline(chains[c].cut, a);
+      const Closest cb = closestOnPolyline(chains[c].cut, b);
+      if (ca.distance > lipTol || cb.distance > lipTol || std::abs(ca.param - cb.param) <= tol ||
+          closestOnPolyline(chains[c].cut, 0.5 * (a + b)).distance > lipTol)
+        continue;
+      Bordering& bd = borders[t];
+      const LipSide side = ca.param < cb.param ? LipSide::Left : LipSide::Right;
+      if (const LipSide* known = bd.sideOf(c); known == nullptr)
+        bd.sides.emplace_back(c, side);
+      else if (*known != side)
+        break;  // both sides of one cut: not a lip (cannot happen in a cut mesh)
+      bd.edgeChain[static_cast<std::size_t>(k)] = static_cast<int>(c);
+      break;
     }
   }
+  return borders;
+}
 
-  // 2. The other triangles the detail path may reach into: nearer to the cut
-  // than the support width. Their side is that of their points beside the
-  // cut (whose nearest point on it is not an end): a triangle at the tip may
-  // reach around it to the other side, ahead of it.
+// thesis 3.3.4, Fig. 3.25: adds the other triangles the detail path may reach into, nearer to
+// the cut than the support width, on the side of their points beside the cut.
+void nearTriangles(const mesh::SheetMesh& mesh, const std::vector<Chain>& chains,
+                   const AtlasScale& scale, double texel, std::map<int, Bordering>& borders) {
+  const double tol = scale.tol;
+  const double lipTol = scale.lipTol;
   for (std::size_t c = 0; c < chains.size(); ++c) {
     const Chain& ch = chains[c];
     Vec2 clo = Vec2::Constant(kInf), chi = -clo;
@@ -406,7 +425,7 @@ TearAtlas bakeTearAtlas(const mesh::SheetMesh& mesh, const std::vector<TearSegme
     for (int t = 0; t < static_cast<int>(mesh.triangles.size()); ++t) {
       const auto it = borders.find(t);
       if (it != borders.end() && it->second.sideOf(c) != nullptr) continue;
-      const auto p = corners(t);
+      const auto p = cornersOf(mesh, t);
       const Vec2 tlo = p[0].cwiseMin(p[1]).cwiseMin(p[2]), thi = p[0].cwiseMax(p[1]).cwiseMax(p[2]);
       if ((tlo.array() > chi.array()).any() || (thi.array() < clo.array()).any()) continue;
       if (!(triangleToPolyline(p, ch.cut) < ch.support)) continue;
@@ -422,74 +441,131 @@ TearAtlas bakeTearAtlas(const mesh::SheetMesh& mesh, const std::vector<TearSegme
       borders[t].sides.emplace_back(c, left > 0 ? LipSide::Left : LipSide::Right);
     }
   }
+}
+
+// thesis 3.3.4, Fig. 3.25: triangle t's patch outline, its lip edges extended by their
+// support quads, with its tear and side (the first chain it has a lip edge on).
+TearPatch patchOutline(const mesh::SheetMesh& mesh, const std::vector<Chain>& chains, int t,
+                       const Bordering& bd, double lipTol) {
+  TearPatch patch;
+  patch.triangle = t;
+  const auto* first = &bd.sides.front();
+  for (const auto& s : bd.sides)
+    if (std::find(bd.edgeChain.begin(), bd.edgeChain.end(), static_cast<int>(s.first)) !=
+        bd.edgeChain.end()) {
+      first = &s;
+      break;
+    }
+  patch.tear = chains[first->first].tear;
+  patch.side = first->second;
+  const auto p = cornersOf(mesh, t);
+  for (int k = 0; k < 3; ++k) {
+    patch.polygon.push_back(p[static_cast<std::size_t>(k)]);
+    const int c = bd.edgeChain[static_cast<std::size_t>(k)];
+    if (c < 0) continue;
+    patch.lipEdges = static_cast<std::uint8_t>(patch.lipEdges | (1u << k));
+    const Chain& ch = chains[static_cast<std::size_t>(c)];
+    const LipSide side = *bd.sideOf(static_cast<std::size_t>(c));
+    const Vec2& a = p[static_cast<std::size_t>(k)];
+    const Vec2& b = p[static_cast<std::size_t>((k + 1) % 3)];
+    const Vec2 d = (b - a).normalized();
+    const Vec2 out(d.y(), -d.x());  // away from the triangle
+    const double w = ch.support;
+    patch.polygon.push_back(a + w * out - (ch.turnsAwayFromQuads(a, side, lipTol) ? w : 0.0) * d);
+    patch.polygon.push_back(b + w * out + (ch.turnsAwayFromQuads(b, side, lipTol) ? w : 0.0) * d);
+  }
+  return patch;
+}
+
+// thesis 3.3.4 (T_left, T_right): a patch's rect on the shared texel grid with a texel to
+// spare around its outline, and its mask, paper on the patch's side of every path it borders.
+std::vector<std::uint8_t> patchMask(TearPatch& patch, const Bordering& bd, double texel,
+                                    std::vector<SideTiles>& sides, long long& texels) {
+  Vec2 plo = Vec2::Constant(kInf), phi = -plo;
+  for (const Vec2& q : patch.polygon) {
+    plo = plo.cwiseMin(q);
+    phi = phi.cwiseMax(q);
+  }
+  const long long x0 = static_cast<long long>(std::floor(plo.x() / texel)) - 1;
+  const long long y0 = static_cast<long long>(std::floor(plo.y() / texel)) - 1;
+  const long long x1 = static_cast<long long>(std::ceil(phi.x() / texel)) + 1;
+  const long long y1 = static_cast<long long>(std::ceil(phi.y() / texel)) + 1;
+  texels += (x1 - x0) * (y1 - y0);
+  if (texels > kMaxAtlasTexels)
+    throw std::length_error("bakeTearAtlas: the patches need over 2^28 texels");
+  patch.rect.width = static_cast<int>(x1 - x0);
+  patch.rect.height = static_cast<int>(y1 - y0);
+  patch.rect.origin = Vec2(static_cast<double>(x0) * texel, static_cast<double>(y0) * texel);
+  std::vector<std::uint8_t> m(static_cast<std::size_t>((x1 - x0) * (y1 - y0)));
+  for (long long j = y0; j < y1; ++j)
+    for (long long i = x0; i < x1; ++i) {
+      // Paper on the patch's side of every path it borders; beyond a
+      // tear's ends the paper is whole.
+      bool paper = true;
+      for (const auto& [c, side] : bd.sides) {
+        const TexelSide at = sides[c].at(i, j);
+        paper =
+            paper && (at == kBeyondTheEnds || at == static_cast<TexelSide>(side == LipSide::Left));
+      }
+      m[static_cast<std::size_t>((j - y0) * (x1 - x0) + (i - x0))] = paper ? 255 : 0;
+    }
+  return m;
+}
+
+// thesis 3.3.4, Fig. 3.25: the patches of the bordering triangles into the atlas, and their
+// masks.
+std::vector<std::vector<std::uint8_t>> bakePatches(const mesh::SheetMesh& mesh,
+                                                   const std::vector<Chain>& chains,
+                                                   const std::map<int, Bordering>& borders,
+                                                   const AtlasScale& scale, double texel,
+                                                   TearAtlas& atlas) {
+  std::vector<SideTiles> sides;
+  sides.reserve(chains.size());
+  for (const Chain& c : chains) sides.emplace_back(c, texel, scale.tol);
+  std::vector<std::vector<std::uint8_t>> masks;
+  long long texels = 0;
+  for (const auto& [t, bd] : borders) {
+    TearPatch patch = patchOutline(mesh, chains, t, bd, scale.lipTol);
+    std::vector<std::uint8_t> m = patchMask(patch, bd, texel, sides, texels);
+    atlas.patches.push_back(std::move(patch));
+    masks.push_back(std::move(m));
+  }
+  return masks;
+}
+
+}  // namespace
+
+TearAtlas bakeTearAtlas(const mesh::SheetMesh& mesh, const std::vector<TearSegment>& segments,
+                        const TearAtlasParams& params) {
+  if (!(params.texelSize > 0.0) || !std::isfinite(params.texelSize))
+    throw std::invalid_argument("bakeTearAtlas: texel size must be finite and > 0");
+  if (!(params.margin >= 0.0) || !std::isfinite(params.margin))
+    throw std::invalid_argument("bakeTearAtlas: margin must be finite and >= 0");
+  const double texel = params.texelSize;
+  TearAtlas atlas;
+  atlas.texelSize = texel;
+
+  // Lengths below tol are coincident points (the cut's points are the
+  // mesh's pattern positions).
+  const AtlasScale scale = atlasScale(mesh, segments, params);
+  const std::vector<Chain> chains = tearChains(segments, scale, params);
+
+  // 1. Lip edges: boundary edges on a cut; the triangle's side is the cut's
+  // side its interior is on (counter-clockwise triangles: left of the edge
+  // walked from corner k to corner k + 1).
+  std::map<int, Bordering> borders = lipTriangles(mesh, chains, scale);
+
+  // 2. The other triangles the detail path may reach into: nearer to the cut
+  // than the support width. Their side is that of their points beside the
+  // cut (whose nearest point on it is not an end): a triangle at the tip may
+  // reach around it to the other side, ahead of it.
+  nearTriangles(mesh, chains, scale, texel, borders);
 
   // 3. The patches: outlines with their support quads (Fig. 3.25), rects on
   // the shared texel grid with a texel to spare around the outline (the
   // renderers' bilinear lookups stay inside), masks.
-  std::vector<SideTiles> sides;
-  sides.reserve(chains.size());
-  for (const Chain& c : chains) sides.emplace_back(c, texel, tol);
-  std::vector<std::vector<std::uint8_t>> masks;
-  long long texels = 0;
-  for (const auto& [t, bd] : borders) {
-    TearPatch patch;
-    patch.triangle = t;
-    const auto* first = &bd.sides.front();
-    for (const auto& s : bd.sides)
-      if (std::find(bd.edgeChain.begin(), bd.edgeChain.end(), static_cast<int>(s.first)) !=
-          bd.edgeChain.end()) {
-        first = &s;
-        break;
-      }
-    patch.tear = chains[first->first].tear;
-    patch.side = first->second;
-    const auto p = corners(t);
-    for (int k = 0; k < 3; ++k) {
-      patch.polygon.push_back(p[static_cast<std::size_t>(k)]);
-      const int c = bd.edgeChain[static_cast<std::size_t>(k)];
-      if (c < 0) continue;
-      patch.lipEdges = static_cast<std::uint8_t>(patch.lipEdges | (1u << k));
-      const Chain& ch = chains[static_cast<std::size_t>(c)];
-      const LipSide side = *bd.sideOf(static_cast<std::size_t>(c));
-      const Vec2& a = p[static_cast<std::size_t>(k)];
-      const Vec2& b = p[static_cast<std::size_t>((k + 1) % 3)];
-      const Vec2 d = (b - a).normalized();
-      const Vec2 out(d.y(), -d.x());  // away from the triangle
-      const double w = ch.support;
-      patch.polygon.push_back(a + w * out - (ch.turnsAwayFromQuads(a, side, lipTol) ? w : 0.0) * d);
-      patch.polygon.push_back(b + w * out + (ch.turnsAwayFromQuads(b, side, lipTol) ? w : 0.0) * d);
-    }
-    Vec2 plo = Vec2::Constant(kInf), phi = -plo;
-    for (const Vec2& q : patch.polygon) {
-      plo = plo.cwiseMin(q);
-      phi = phi.cwiseMax(q);
-    }
-    const long long x0 = static_cast<long long>(std::floor(plo.x() / texel)) - 1;
-    const long long y0 = static_cast<long long>(std::floor(plo.y() / texel)) - 1;
-    const long long x1 = static_cast<long long>(std::ceil(phi.x() / texel)) + 1;
-    const long long y1 = static_cast<long long>(std::ceil(phi.y() / texel)) + 1;
-    texels += (x1 - x0) * (y1 - y0);
-    if (texels > kMaxAtlasTexels)
-      throw std::length_error("bakeTearAtlas: the patches need over 2^28 texels");
-    patch.rect.width = static_cast<int>(x1 - x0);
-    patch.rect.height = static_cast<int>(y1 - y0);
-    patch.rect.origin = Vec2(static_cast<double>(x0) * texel, static_cast<double>(y0) * texel);
-    std::vector<std::uint8_t> m(static_cast<std::size_t>((x1 - x0) * (y1 - y0)));
-    for (long long j = y0; j < y1; ++j)
-      for (long long i = x0; i < x1; ++i) {
-        // Paper on the patch's side of every path it borders; beyond a
-        // tear's ends the paper is whole.
-        bool paper = true;
-        for (const auto& [c, side] : bd.sides) {
-          const TexelSide at = sides[c].at(i, j);
-          paper = paper &&
-                  (at == kBeyondTheEnds || at == static_cast<TexelSide>(side == LipSide::Left));
-        }
-        m[static_cast<std::size_t>((j - y0) * (x1 - x0) + (i - x0))] = paper ? 255 : 0;
-      }
-    atlas.patches.push_back(std::move(patch));
-    masks.push_back(std::move(m));
-  }
+  const std::vector<std::vector<std::uint8_t>> masks =
+      bakePatches(mesh, chains, borders, scale, texel, atlas);
 
   // 4. One atlas.
   pack(atlas);
