@@ -301,7 +301,7 @@ void HybridSheet::restoreState(StateReader& in) {
   m.elastic->restoreState(in);
 }
 
-// Issue 6, thesis 3.3.3 "Remeshing" (Figs. 3.20-3.23).
+// Thesis 3.3.3 "Remeshing" (Figs. 3.20-3.23).
 std::optional<std::vector<GeometricCutResult>> HybridSheet::tear(
     const std::vector<TearAdvance>& advances, const GeometricCutOptions& options) {
   Impl& m = *impl_;
