@@ -17,7 +17,8 @@
 //
 // - Time: median wall time of --runs renders at each N (interleaved, ours
 //   then Cycles, so both see the same machine load). Ours: a fresh
-//   EmbreeRenderer (device) + render() (scene/BVH build and path tracing).
+//   renderer (makeRenderer(Backend::Embree): the Embree device) + render()
+//   (render geometry, scene/BVH build and path tracing).
 //   Cycles: the time around bpy.ops.render.render() (scene sync, BVH,
 //   shader compilation, path tracing) reported by the script; Blender's
 //   start-up and the Python scene creation are reported apart.
@@ -55,6 +56,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -67,7 +69,7 @@
 #include "crumple/exporters/png.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/shot.hpp"
-#include "crumple/render/embree_renderer.hpp"
+#include "crumple/render/renderer.hpp"
 #include "crumple/render/view.hpp"
 #include "json_number.hpp"
 
@@ -348,22 +350,24 @@ struct Timed {
 
 Timed renderOurs(const pipeline::FrameView& fv, int spp, const Options& o, std::uint64_t seed,
                  int frame, render::RenderPass pass = render::RenderPass::Beauty) {
-  render::PathTraceSettings settings;
-  settings.samplesPerPixel = spp;
-  settings.maxBounces = o.maxBounces;
-  settings.seed = seed;
+  render::RendererOptions options;
+  options.samplesPerPixel = spp;
+  options.maxBounces = o.maxBounces;
+  options.seed = seed;
+  render::FrameSettings settings;
   settings.frame = frame;
-  settings.pass = pass;
   Timed t;
   const double cpu0 = cpuMs();
   const auto start = Clock::now();
-  render::EmbreeRenderer renderer;
-  t.image = renderer.render(fv.scene, fv.sheet, settings);
+  const std::unique_ptr<render::Renderer> renderer =
+      render::makeRenderer(render::Backend::Embree, options);
+  const render::RenderedImage image = renderer->render(fv.scene, fv.sheet, settings, pass);
   t.ms = msSince(start);
   t.cpuMs = cpuMs() - cpu0;
-  if (renderer.droppedSamples() > 0)
+  t.image = image.linear();
+  if (renderer->droppedSamples() > 0)
     std::fprintf(stderr, "bench_render: ours dropped %llu non-finite samples\n",
-                 static_cast<unsigned long long>(renderer.droppedSamples()));
+                 static_cast<unsigned long long>(renderer->droppedSamples()));
   return t;
 }
 

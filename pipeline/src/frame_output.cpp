@@ -14,8 +14,7 @@
 #include "crumple/exporters/exr.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/render/contact_sheet.hpp"
-#include "crumple/render/embree_renderer.hpp"
-#include "crumple/render/osmesa_renderer.hpp"
+#include "crumple/render/renderer.hpp"
 
 extern char** environ;
 
@@ -54,62 +53,45 @@ render::StructureOverlay structureOverlay(const cache::FrameRecord& frame) {
 }  // namespace
 
 struct FrameRenderer::Impl {
-  const io::SceneSpec& scene;
   std::string framesDir;
   bool debugStructure = false;
   RenderSettings settings;
-  std::uint64_t seed = 0;
   FrameViewBuilder views;
-  std::unique_ptr<render::OsmesaRenderer> osmesa;
-  std::unique_ptr<render::EmbreeRenderer> embree;
+  std::unique_ptr<render::Renderer> renderer;
 
-  Impl(const io::SceneSpec& s, const std::vector<cache::ExtensionBlock>& headerBlocks,
-       std::string dir, bool debug, const RenderSettings& r, std::uint64_t sd)
-      : scene(s),
-        framesDir(std::move(dir)),
-        debugStructure(debug),
-        settings(r),
-        seed(sd),
-        views(s, headerBlocks) {
-    if (settings.backend == RenderSettings::Backend::Embree) {
-      if (debugStructure)
-        throw InputError("--debug-structure",
-                         "the structure view is drawn by the osmesa backend only");
-      embree = std::make_unique<render::EmbreeRenderer>();
-    } else {
-      osmesa = std::make_unique<render::OsmesaRenderer>(scene.camera.width, scene.camera.height);
-    }
+  Impl(const io::SceneSpec& scene, const std::vector<cache::ExtensionBlock>& headerBlocks,
+       std::string dir, bool debug, const RenderSettings& r, std::uint64_t seed)
+      : framesDir(std::move(dir)), debugStructure(debug), settings(r), views(scene, headerBlocks) {
+    const bool embree = settings.backend == RenderSettings::Backend::Embree;
+    if (embree && debugStructure)
+      throw InputError("--debug-structure",
+                       "the structure view is drawn by the osmesa backend only");
+    render::RendererOptions options;
+    options.width = scene.camera.width;
+    options.height = scene.camera.height;
+    options.samplesPerPixel = settings.samplesPerPixel;
+    options.maxBounces = settings.maxBounces;
+    options.seed = seed;
+    renderer =
+        render::makeRenderer(embree ? render::Backend::Embree : render::Backend::Osmesa, options);
   }
 
   void render(const cache::FrameRecord& frame) {
     const FrameView fv = views.build(frame);
-    const fs::path dir(framesDir);
-    if (embree) {
-      render::PathTraceSettings pt;
-      pt.samplesPerPixel = settings.samplesPerPixel;
-      pt.maxBounces = settings.maxBounces;
-      pt.seed = seed;
-      pt.frame = frame.frame;
-      pt.pass = settings.pass;
-      const ImageRGBAF image = embree->render(fv.scene, fv.sheet, pt);
-      if (settings.exr)
-        exporters::writeExr((dir / frameFileName(frame.frame, "exr")).string(), image);
-      if (settings.png)
-        exporters::writePng((dir / frameFileName(frame.frame)).string(),
-                            render::toSrgb8(image, fv.scene.background));
-      return;
-    }
-    ImageRGBA8 image;
+    render::FrameSettings frameSettings;
+    frameSettings.frame = frame.frame;
+    std::optional<render::StructureOverlay> overlay;
     if (debugStructure) {
-      const render::StructureOverlay overlay = structureOverlay(frame);
-      image = osmesa->render(fv.scene, fv.sheet, &overlay, settings.pass);
-    } else {
-      image = osmesa->render(fv.scene, fv.sheet, nullptr, settings.pass);
+      overlay = structureOverlay(frame);
+      frameSettings.overlay = &*overlay;
     }
+    const render::RenderedImage image =
+        renderer->render(fv.scene, fv.sheet, frameSettings, settings.pass);
+    const fs::path dir(framesDir);
     if (settings.exr)
-      exporters::writeExr((dir / frameFileName(frame.frame, "exr")).string(),
-                          render::decodeSrgb8(image, /*premultiply=*/true));
-    if (settings.png) exporters::writePng((dir / frameFileName(frame.frame)).string(), image);
+      exporters::writeExr((dir / frameFileName(frame.frame, "exr")).string(), image.linear());
+    if (settings.png)
+      exporters::writePng((dir / frameFileName(frame.frame)).string(), image.srgb8());
   }
 };
 

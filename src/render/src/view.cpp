@@ -8,6 +8,7 @@
 #include <string>
 
 #include "crumple/mesh/sheet_mesh.hpp"
+#include "render_geometry.hpp"
 
 namespace crumple::render {
 
@@ -143,6 +144,14 @@ double srgb8ToLinear(std::uint8_t srgb) {
 }
 
 ImageRGBAF decodeSrgb8(const ImageRGBA8& image, bool premultiply) {
+  // srgb8ToLinear of every 8-bit level, rounded to float once.
+  static const std::array<float, 256> kLinear = [] {
+    std::array<float, 256> t{};
+    for (int i = 0; i < 256; ++i)
+      t[static_cast<std::size_t>(i)] =
+          static_cast<float>(srgb8ToLinear(static_cast<std::uint8_t>(i)));
+    return t;
+  }();
   ImageRGBAF out(image.width, image.height);
   for (int y = 0; y < image.height; ++y)
     for (int x = 0; x < image.width; ++x) {
@@ -150,7 +159,7 @@ ImageRGBAF decodeSrgb8(const ImageRGBA8& image, bool premultiply) {
       float* q = out.at(x, y);
       const float a = static_cast<float>(p[3]) / 255.0f;
       const float scale = premultiply ? a : 1.0f;
-      for (int k = 0; k < 3; ++k) q[k] = static_cast<float>(srgb8ToLinear(p[k])) * scale;
+      for (int k = 0; k < 3; ++k) q[k] = kLinear[p[k]] * scale;
       q[3] = a;
     }
   return out;
@@ -182,75 +191,8 @@ std::vector<std::array<Vec3, 3>> shadingNormals(const std::vector<Vec3>& positio
                                                 const std::vector<std::array<int, 3>>& triangles,
                                                 double creaseAngle,
                                                 const std::vector<int>& sharpVertices) {
-  const std::size_t nt = triangles.size();
-  const std::size_t nv = positions.size();
-  std::vector<Vec3> face(nt);
-  for (std::size_t t = 0; t < nt; ++t) {
-    const auto& tri = triangles[t];
-    const Vec3 n =
-        (positions[static_cast<std::size_t>(tri[1])] - positions[static_cast<std::size_t>(tri[0])])
-            .cross(positions[static_cast<std::size_t>(tri[2])] -
-                   positions[static_cast<std::size_t>(tri[0])]);
-    const double len = n.norm();
-    face[t] = len > 0.0 ? Vec3(n / len) : Vec3::Zero();
-  }
-  // Corners of each vertex, and the triangles on each side of every edge.
-  std::vector<std::vector<std::pair<std::size_t, int>>> corners(nv);
-  for (std::size_t t = 0; t < nt; ++t)
-    for (int k = 0; k < 3; ++k)
-      corners[static_cast<std::size_t>(triangles[t][k])].push_back({t, k});
-  std::vector<bool> sharp(nv, false);
-  for (const int v : sharpVertices)
-    if (v >= 0 && static_cast<std::size_t>(v) < nv) sharp[static_cast<std::size_t>(v)] = true;
-  const double cosCrease = std::cos(creaseAngle);
-
-  std::vector<std::array<Vec3, 3>> out(nt);
-  for (std::size_t t = 0; t < nt; ++t)
-    for (int k = 0; k < 3; ++k) out[t][static_cast<std::size_t>(k)] = face[t];
-
-  std::vector<int> group;  // per corner of the current vertex: its smoothing group
-  for (std::size_t v = 0; v < nv; ++v) {
-    const auto& cs = corners[v];
-    if (cs.size() < 2 || sharp[v]) continue;
-    // Two corners of v are joined when their triangles share an edge at v
-    // whose dihedral angle is below the crease angle (union-find).
-    group.assign(cs.size(), 0);
-    for (std::size_t i = 0; i < cs.size(); ++i) group[i] = static_cast<int>(i);
-    auto find = [&](int i) {
-      while (group[static_cast<std::size_t>(i)] != i) i = group[static_cast<std::size_t>(i)];
-      return i;
-    };
-    for (std::size_t i = 0; i < cs.size(); ++i)
-      for (std::size_t j = i + 1; j < cs.size(); ++j) {
-        const auto& ti = triangles[cs[i].first];
-        const auto& tj = triangles[cs[j].first];
-        int shared = 0;
-        for (const int a : ti)
-          for (const int b : tj)
-            if (a == b) ++shared;
-        if (shared != 2) continue;
-        if (face[cs[i].first].dot(face[cs[j].first]) <= cosCrease) continue;
-        const int gi = find(static_cast<int>(i)), gj = find(static_cast<int>(j));
-        if (gi != gj) group[static_cast<std::size_t>(std::max(gi, gj))] = std::min(gi, gj);
-      }
-    // Angle-weighted sums per group.
-    std::vector<Vec3> sum(cs.size(), Vec3::Zero());
-    for (std::size_t i = 0; i < cs.size(); ++i) {
-      const auto& tri = triangles[cs[i].first];
-      const int k = cs[i].second;
-      const Vec3& p = positions[v];
-      const Vec3 e1 = positions[static_cast<std::size_t>(tri[(k + 1) % 3])] - p;
-      const Vec3 e2 = positions[static_cast<std::size_t>(tri[(k + 2) % 3])] - p;
-      const double angle = std::atan2(e1.cross(e2).norm(), e1.dot(e2));
-      sum[static_cast<std::size_t>(find(static_cast<int>(i)))] += angle * face[cs[i].first];
-    }
-    for (std::size_t i = 0; i < cs.size(); ++i) {
-      const Vec3& s = sum[static_cast<std::size_t>(find(static_cast<int>(i)))];
-      const double len = s.norm();
-      if (len > 1e-12) out[cs[i].first][static_cast<std::size_t>(cs[i].second)] = s / len;
-    }
-  }
-  return out;
+  return detail::shadingNormals(positions, triangles, detail::faceNormals(positions, triangles),
+                                creaseAngle, sharpVertices);
 }
 
 Vec4 sampleTexture(const ImageRGBA8& texture, const Vec2& uv) {

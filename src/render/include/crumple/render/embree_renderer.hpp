@@ -25,10 +25,13 @@
 
 #include "crumple/core/image.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
+#include "crumple/render/renderer.hpp"
 #include "crumple/render/view.hpp"
 
 namespace crumple::render {
 
+// One path-traced frame's settings (the Renderer interface takes them from
+// RendererOptions and FrameSettings).
 struct PathTraceSettings {
   int samplesPerPixel = 16;  // >= 1
   int maxBounces = 4;        // diffuse bounces after the first hit (0 = direct light only)
@@ -37,15 +40,14 @@ struct PathTraceSettings {
   RenderPass pass = RenderPass::Beauty;
 };
 
-class EmbreeRenderer {
+class EmbreeRenderer final : public Renderer {
  public:
   // Creates the Embree device; its BVH builds use crumple::threadCount()
   // threads (as set when the renderer is created). Throws std::runtime_error
-  // naming Embree's error when it cannot.
-  EmbreeRenderer();
-  ~EmbreeRenderer();
-  EmbreeRenderer(const EmbreeRenderer&) = delete;
-  EmbreeRenderer& operator=(const EmbreeRenderer&) = delete;
+  // naming Embree's error when it cannot. The Renderer interface's renders
+  // use the options' samples per pixel, bounces and seed (not its size).
+  explicit EmbreeRenderer(const RendererOptions& options = {});
+  ~EmbreeRenderer() override;
 
   // Renders one frame at the camera's resolution. Throws
   // std::invalid_argument on inconsistent or non-finite input (as
@@ -55,17 +57,23 @@ class EmbreeRenderer {
   ImageRGBAF render(const RenderScene& scene, const mesh::SheetMesh& sheet,
                     const PathTraceSettings& settings);
 
+  // The Renderer interface: the render above with the options' settings and
+  // the frame's number and pass; the rendered image's linear() is its image
+  // and srgb8() toSrgb8 of it on the scene's background. Throws
+  // std::invalid_argument on a non-empty overlay.
+  RenderedImage render(const RenderScene& scene, const mesh::SheetMesh& sheet,
+                       const FrameSettings& settings, RenderPass pass) override;
+
+  // Backend::Embree.
+  Backend backend() const override { return Backend::Embree; }
+
   // Samples dropped as non-finite by the last render().
-  std::uint64_t droppedSamples() const;
+  std::uint64_t droppedSamples() const override;
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  RendererOptions options_;
 };
-
-// Premultiplied linear RGBA -> 8-bit sRGB with straight alpha (PNG frames):
-// colour = rgb / alpha encoded with linearToSrgb8, alpha rounded to 8 bits;
-// pixels with alpha 0 get `background` (linear) encoded, alpha 0.
-ImageRGBA8 toSrgb8(const ImageRGBAF& image, const Vec3& background);
 
 }  // namespace crumple::render

@@ -43,18 +43,19 @@
 
 #include "crumple/core/image.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
+#include "crumple/render/renderer.hpp"
 #include "crumple/render/view.hpp"
 
 namespace crumple::render {
 
-class OsmesaRenderer {
+class OsmesaRenderer final : public Renderer {
  public:
   // Creates an offscreen context of the given size. Throws std::runtime_error
   // if OSMesa cannot create a context.
   OsmesaRenderer(int width, int height);
-  ~OsmesaRenderer();
-  OsmesaRenderer(const OsmesaRenderer&) = delete;
-  OsmesaRenderer& operator=(const OsmesaRenderer&) = delete;
+  // The same, of the options' width and height.
+  explicit OsmesaRenderer(const RendererOptions& options);
+  ~OsmesaRenderer() override;
 
   // Draws the sheet (positions, triangles, pattern as texture coordinates)
   // and, when `overlay` is given, the structure view over it (see
@@ -68,6 +69,18 @@ class OsmesaRenderer {
   ImageRGBA8 render(const RenderScene& scene, const mesh::SheetMesh& sheet,
                     const StructureOverlay* overlay = nullptr,
                     RenderPass pass = RenderPass::Beauty);
+
+  // The Renderer interface: the render above with the frame's overlay; the
+  // rendered image's srgb8() is its 8-bit image and linear() that image
+  // decoded (decodeSrgb8, premultiplied).
+  RenderedImage render(const RenderScene& scene, const mesh::SheetMesh& sheet,
+                       const FrameSettings& settings, RenderPass pass) override;
+
+  // Backend::Osmesa.
+  Backend backend() const override { return Backend::Osmesa; }
+
+  // 0: the rasteriser drops no samples.
+  std::uint64_t droppedSamples() const override { return 0; }
 
  private:
   struct Impl;

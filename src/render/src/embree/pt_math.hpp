@@ -1,6 +1,6 @@
 #pragma once
 // Small single-precision vector helpers for the path tracer's inner loop
-// (embree_renderer.cpp): plain structs, no allocation, no Eigen overhead.
+// (integrator.cpp): plain structs, no allocation, no Eigen overhead.
 #include <cmath>
 #include <numbers>
 

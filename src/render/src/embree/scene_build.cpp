@@ -1,0 +1,295 @@
+#include "scene_build.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <numbers>
+#include <stdexcept>
+#include <utility>
+
+#include "crumple/core/parallel.hpp"
+
+namespace crumple::render::pt {
+
+namespace {
+
+// Embree's error code as text.
+const char* errorName(RTCError e) {
+  switch (e) {
+    case RTC_ERROR_NONE:
+      return "no error";
+    case RTC_ERROR_UNKNOWN:
+      return "unknown error";
+    case RTC_ERROR_INVALID_ARGUMENT:
+      return "invalid argument";
+    case RTC_ERROR_INVALID_OPERATION:
+      return "invalid operation";
+    case RTC_ERROR_OUT_OF_MEMORY:
+      return "out of memory";
+    case RTC_ERROR_UNSUPPORTED_CPU:
+      return "unsupported CPU";
+    case RTC_ERROR_CANCELLED:
+      return "cancelled";
+  }
+  return "unrecognised error";
+}
+
+// Embree intersect/occluded filter: rejects sheet hits where the texture's
+// bilinear alpha is below 0.5 (cut-outs) or, on a tear patch, its mask is
+// (view.hpp), for every kind of ray.
+void alphaCutFilter(const RTCFilterFunctionNArguments* args) {
+  const auto* look = static_cast<const SheetLook*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+    const float u = RTCHitN_u(args->hit, args->N, i);
+    const float v = RTCHitN_v(args->hit, args->N, i);
+    const SheetTri& t = look->tris[prim];
+    if (sampleTexture(*look->texture, sheetUv(t, u, v)).w() < 0.5 ||
+        (t.masked && mesh::sampleTearMask(*look->tears, interpolate(t.maskUv, u, v)) < 0.5))
+      args->valid[i] = 0;
+  }
+}
+
+// The lights in render units (relative positions, radiance per the
+// conventions of view.hpp). Directional: irradiance pi*I*c at normal
+// incidence; Sun: radiance I*c / sin^2(half angle) (the same irradiance at
+// normal incidence); Point: radiant intensity pi*I*c; Area: radiance
+// pi*I*c / area.
+// `lights` are the render geometry's (relative positions, never empty).
+void makeLights(const std::vector<Light>& lights, FrameData& f) {
+  std::uint32_t pair = 0;
+  for (const Light& l : lights) {
+    LightData d;
+    const Vec3 c = l.color * l.intensity;
+    switch (l.kind) {
+      case Light::Kind::Directional: {
+        const Vec3 toLight = -l.direction.normalized();
+        d.dir = toV3(toLight);
+        // Discs below a microradian are delta lights (float range of the radiance).
+        if (l.angle > kMinSunAngle) {
+          const double half = 0.5 * l.angle;
+          const double s = std::sin(half), sh = std::sin(0.5 * half);
+          d.type = LightData::Type::Sun;
+          d.oneMinusCos = static_cast<float>(2.0 * sh * sh);
+          d.pdf = static_cast<float>(1.0 / (2.0 * std::numbers::pi * 2.0 * sh * sh));
+          d.radiance = toV3(c / (s * s));
+          Vec3 u = toLight.unitOrthogonal();
+          d.su = toV3(u);
+          d.sv = toV3(toLight.cross(u));
+          d.pair = pair++;
+          f.sunLights.push_back(static_cast<std::uint32_t>(f.lights.size()));
+        } else {
+          d.type = LightData::Type::Directional;
+          d.radiance = toV3(std::numbers::pi * c);
+        }
+        break;
+      }
+      case Light::Kind::Point:
+        d.type = LightData::Type::Point;
+        d.pos = toV3(l.position);
+        d.radiance = toV3(std::numbers::pi * c);
+        break;
+      case Light::Kind::Area: {
+        d.type = LightData::Type::Area;
+        const auto [u, v] = areaLightFrame(l);
+        const double area = l.size.x() * l.size.y();
+        d.dir = toV3(l.direction.normalized());
+        d.pos = toV3(l.position);
+        d.su = toV3(u);
+        d.sv = toV3(v);
+        d.halfX = static_cast<float>(0.5 * l.size.x());
+        d.halfY = static_cast<float>(0.5 * l.size.y());
+        d.area = static_cast<float>(area);
+        d.radiance = toV3(std::numbers::pi * c / area);
+        d.pair = pair++;
+        f.areaLights.push_back(static_cast<std::uint32_t>(f.lights.size()));
+        break;
+      }
+    }
+    f.lights.push_back(d);
+  }
+  f.pairsPerVertex = pair + 2;  // sampled lights, BSDF, roulette
+}
+
+// The sheet's Embree mesh and shading data: the triangles drawn as they are
+// (sharing the sheet's vertices), then the tear patches' pieces (each corner
+// its own vertex, cut by the patch's mask; thesis 3.3.4, Fig. 3.25).
+MeshData sheetMesh(const mesh::SheetMesh& sheet, const detail::RenderGeometry& g, SheetLook& look) {
+  MeshData m;
+  m.kind = GeomKind::Sheet;
+  m.vertices.reserve(g.positions.size() + 1);
+  for (const detail::Float3& p : g.positions) m.vertices.push_back(V3{p[0], p[1], p[2]});
+  look.tris.reserve(sheet.triangles.size());
+  m.triangles.reserve(sheet.triangles.size());
+  m.faceNormals.reserve(sheet.triangles.size());
+  for (const std::size_t t : g.drawnTriangles) {
+    const auto& tri = sheet.triangles[t];
+    SheetTri& st = look.tris.emplace_back();
+    auto& indices = m.triangles.emplace_back();
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto vi = static_cast<std::size_t>(tri[k]);
+      indices[k] = static_cast<std::uint32_t>(vi);
+      st.normals[k] = toV3(g.cornerNormals[t][k]);
+      st.uv[2 * k] = g.uvs[vi][0];
+      st.uv[2 * k + 1] = g.uvs[vi][1];
+    }
+    m.faceNormals.push_back(toV3(g.faceNormals[t]));
+  }
+  for (const detail::PatchPiece& piece : g.patchPieces) {
+    SheetTri& st = look.tris.emplace_back();
+    st.masked = true;
+    auto& indices = m.triangles.emplace_back();
+    for (std::size_t k = 0; k < 3; ++k) {
+      const detail::PatchCorner& c = piece.corners[k];
+      indices[k] = static_cast<std::uint32_t>(m.vertices.size());
+      m.vertices.push_back(V3{c.position[0], c.position[1], c.position[2]});
+      st.normals[k] = V3{c.normal[0], c.normal[1], c.normal[2]};
+      st.uv[2 * k] = c.uv[0];
+      st.uv[2 * k + 1] = c.uv[1];
+      st.maskUv[2 * k] = static_cast<float>(c.atlas.x());
+      st.maskUv[2 * k + 1] = static_cast<float>(c.atlas.y());
+    }
+    m.faceNormals.push_back(toV3(piece.faceNormal));
+  }
+  return m;
+}
+
+// The ground square's Embree mesh (front +Y).
+MeshData groundMesh(const std::array<Vec3, 4>& corners, const Vec3& color) {
+  MeshData m;
+  m.kind = GeomKind::Ground;
+  m.vertices = {toV3(corners[0]), toV3(corners[1]), toV3(corners[2]), toV3(corners[3])};
+  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  m.faceNormals = {V3{0.0f, 1.0f, 0.0f}, V3{0.0f, 1.0f, 0.0f}};
+  m.color = toV3(color);
+  return m;
+}
+
+// A prop's Embree mesh (flat face normals).
+MeshData propMesh(const detail::PropGeometry& prop) {
+  MeshData m;
+  m.kind = GeomKind::Prop;
+  m.vertices.reserve(prop.vertices.size() + 1);
+  for (const detail::Float3& p : prop.vertices) m.vertices.push_back(V3{p[0], p[1], p[2]});
+  m.triangles.reserve(prop.mesh->triangles.size());
+  m.faceNormals.reserve(prop.mesh->triangles.size());
+  for (std::size_t i = 0; i < prop.mesh->triangles.size(); ++i) {
+    const auto& tri = prop.mesh->triangles[i];
+    m.triangles.push_back({static_cast<std::uint32_t>(tri[0]), static_cast<std::uint32_t>(tri[1]),
+                           static_cast<std::uint32_t>(tri[2])});
+    const detail::Float3& n = prop.faceNormals[i];
+    m.faceNormals.push_back(V3{n[0], n[1], n[2]});
+  }
+  m.color = toV3(prop.mesh->color);
+  return m;
+}
+
+// The camera in render units (relative position, float frame).
+CameraData makeCamera(const Camera& cam) {
+  const Mat3 r = cam.rotation.normalized().toRotationMatrix();
+  CameraData c;
+  c.pos = toV3(cam.position);
+  c.right = toV3(r.col(0));
+  c.up = toV3(r.col(1));
+  c.forward = toV3(-r.col(2));
+  const double tanY = std::tan(0.5 * cam.yfov);
+  c.tanY = static_cast<float>(tanY);
+  c.tanX = static_cast<float>(tanY * cam.width / cam.height);
+  c.invW = 1.0f / static_cast<float>(cam.width);
+  c.invH = 1.0f / static_cast<float>(cam.height);
+  c.lensRadius = static_cast<float>(cam.apertureRadius);
+  c.focus = static_cast<float>(cam.focusDistance);
+  return c;
+}
+
+// Attaches a triangle geometry over m's (shared) buffers to the scene.
+void attach(EmbreeDevice& device, RTCScene scene, MeshData& m, SheetLook* filterLook) {
+  const std::unique_ptr<RTCGeometryTy, decltype(&rtcReleaseGeometry)> g(
+      rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_TRIANGLE), &rtcReleaseGeometry);
+  if (!g) device.check("rtcNewGeometry");
+  m.vertices.push_back(V3{});  // padding: Embree may read 16 bytes at the last vertex
+  rtcSetSharedGeometryBuffer(g.get(), RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                             m.vertices.data(), 0, sizeof(V3), m.vertices.size() - 1);
+  rtcSetSharedGeometryBuffer(g.get(), RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                             m.triangles.data(), 0, sizeof(m.triangles[0]), m.triangles.size());
+  if (filterLook != nullptr) {
+    rtcSetGeometryUserData(g.get(), filterLook);
+    rtcSetGeometryIntersectFilterFunction(g.get(), alphaCutFilter);
+    rtcSetGeometryOccludedFilterFunction(g.get(), alphaCutFilter);
+  }
+  rtcCommitGeometry(g.get());
+  rtcAttachGeometry(scene, g.get());
+  device.check("geometry setup");
+}
+
+}  // namespace
+
+EmbreeDevice::EmbreeDevice() {
+  // Embree's own (TBB) threads build the BVH: as many as crumple may use, so
+  // that `--threads 1` on a farm node keeps to one core.
+  const std::string config = "threads=" + std::to_string(threadCount());
+  device_.reset(rtcNewDevice(config.c_str()));
+  if (!device_)
+    throw std::runtime_error(std::string("EmbreeRenderer: rtcNewDevice failed: ") +
+                             errorName(rtcGetDeviceError(nullptr)));
+  rtcSetDeviceErrorFunction(device_.get(), &EmbreeDevice::onError, this);
+}
+
+void EmbreeDevice::onError(void* user, RTCError code, const char* message) {
+  auto* self = static_cast<EmbreeDevice*>(user);
+  const std::lock_guard<std::mutex> lock(self->errorMutex_);
+  self->lastError_ = std::string(errorName(code)) + (message ? std::string(": ") + message : "");
+}
+
+void EmbreeDevice::check(const char* where) {
+  const RTCError e = rtcGetDeviceError(device_.get());
+  if (e == RTC_ERROR_NONE) return;
+  const std::lock_guard<std::mutex> lock(errorMutex_);
+  throw std::runtime_error(std::string("EmbreeRenderer: Embree error in ") + where + ": " +
+                           (lastError_.empty() ? errorName(e) : lastError_));
+}
+
+FrameData buildFrameData(const RenderScene& scene, const mesh::SheetMesh& sheet,
+                         const detail::RenderGeometry& g, const PathTraceSettings& settings) {
+  FrameData f;
+  f.maxBounces = settings.maxBounces;
+  f.spp = settings.samplesPerPixel;
+  f.epsScene = static_cast<float>(1e-5 * std::max(g.sheetSize, 1e-2));
+  f.meshes.reserve(2 + scene.props.size());
+
+  f.sheet.texture =
+      scene.paper.texture.pixels.empty() ? &defaultPaperTexture() : &scene.paper.texture;
+  f.sheet.front = toV3(scene.paper.frontColor);
+  f.sheet.back = toV3(scene.paper.backColor);
+  f.sheet.transmittance = static_cast<float>(scene.paper.transmittance);
+  f.sheet.tears = &scene.tears;
+  if (!sheet.triangles.empty()) f.meshes.push_back(sheetMesh(sheet, g, f.sheet));
+  if (g.ground) f.meshes.push_back(groundMesh(*g.ground, scene.ground.color));
+  for (const detail::PropGeometry& prop : g.props)
+    if (!prop.mesh->triangles.empty()) f.meshes.push_back(propMesh(prop));
+
+  makeLights(g.lights, f);
+  const Vec3 env = scene.environment.color * scene.environment.intensity;
+  f.environment = toV3(env);
+  f.hasEnvironment = !isBlack(f.environment);
+  f.camera = makeCamera(g.camera);
+  return f;
+}
+
+ScenePtr buildScene(EmbreeDevice& device, FrameData& f, bool cutSheet) {
+  std::size_t triangles = 0;
+  for (const MeshData& m : f.meshes) triangles += m.triangles.size();
+  ScenePtr scene(rtcNewScene(device.get()));
+  if (!scene) device.check("rtcNewScene");
+  rtcSetSceneFlags(scene.get(), RTC_SCENE_FLAG_NONE);
+  rtcSetSceneBuildQuality(scene.get(),
+                          triangles <= 200000 ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
+  for (MeshData& m : f.meshes)
+    attach(device, scene.get(), m, m.kind == GeomKind::Sheet && cutSheet ? &f.sheet : nullptr);
+  rtcCommitScene(scene.get());
+  device.check("rtcCommitScene");
+  return scene;
+}
+
+}  // namespace crumple::render::pt
