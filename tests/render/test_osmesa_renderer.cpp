@@ -434,7 +434,7 @@ TEST(OsmesaRenderer, RejectsBadInput) {
   EXPECT_EQ(r.render(s, sheet).width, 32);
 }
 
-// --- materials, lights and passes of issue 4 --------------------------------
+// --- materials, lights and passes -----------------------------------------
 
 // A white texture with a transparent window over uv [0.375, 0.625]^2: on the
 // flat sheet, world |X| < W/8 and |Z| < H/8 around the sheet's centre.
