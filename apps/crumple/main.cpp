@@ -92,7 +92,7 @@ void addRenderCommand(CLI::App& app, Args& a, Commands& c) {
                      "frames folder (default: frames/ beside the cache); locked while rendering "
                      "(exit 2 when another crumple writes there), shared by renders of a "
                      "--frames range (a farm's array tasks)");
-  render
+  c.render
       ->add_option("--threads", a.threads,
                    "embree: worker threads (the images are identical for any count); osmesa: "
                    "the rasteriser sizes its own threads (LP_NUM_THREADS), identical images too")
@@ -111,7 +111,7 @@ void addCacheCommands(CLI::App& app, Args& a, Commands& c) {
                        "the WAV file, or a folder to write sound.wav into (default: sound.wav "
                        "beside the cache); its folder is locked while writing (exit 2 when "
                        "another crumple writes there)");
-  soundCmd
+  c.soundCmd
       ->add_option("--rate", a.rate, "sample rate: 48000 or 44100 (default: the scene's, 48000)")
       ->check(CLI::IsMember({48000, 44100}));
   c.soundCmd->add_option("--format", a.format,
@@ -140,12 +140,12 @@ void addCacheCommands(CLI::App& app, Args& a, Commands& c) {
   c.compare->add_option("--frames", a.frames,
                       "caches: A-B, the frames to compare (default: all shared)");
   c.compare->add_flag("--json", a.json, "caches: one JSON object for scripts");
-  compare
+  c.compare
       ->add_option("--metric", a.metric,
                    "mae: mean |difference| over RGBA in 8-bit units; psnr: dB over RGBA; flip: "
                    "mean LDR-FLIP error in [0, 1] (Andersson et al. 2020) of the images over grey")
       ->capture_default_str();
-  compare
+  c.compare
       ->add_option("--tolerance", a.tolerance,
                    "pass when mae/flip <= tolerance, or psnr >= tolerance")
       ->capture_default_str();
@@ -192,7 +192,7 @@ void addFarmCommand(CLI::App& app, Args& a, Commands& c) {
       ->capture_default_str();
   c.farmSlurm->add_option("--partition", a.slurm.partition, "sbatch --partition of every job");
   c.farmSlurm->add_option("--time", a.slurm.time, "sbatch --time of every job (e.g. 1:00:00)");
-  farmSlurm
+  c.farmSlurm
       ->add_option("--cpus-per-task", a.slurm.cpusPerTask,
                    "sbatch --cpus-per-task of every job, and its crumple --threads")
       ->check(CLI::PositiveNumber);
