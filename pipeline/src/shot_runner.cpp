@@ -71,7 +71,8 @@ ShotRunner::ShotRunner(const io::SceneSpec& scene, const ShotOptions& options)
     : scene_(scene), plan_(planShot(scene, options)), guard_(plan_.frameBudget) {
   report_.outDir = plan_.outDir;
   if (!scene.animationFile.empty()) {
-    animation_ = std::make_unique<io::AnimationScene>(io::AnimationScene::load(scene.animationFile));
+    animation_ =
+        std::make_unique<io::AnimationScene>(io::AnimationScene::load(scene.animationFile));
     io::checkAnimationNodes(scene, *animation_);
   }
   // What a checkpoint records of the files read (docs/CHECKPOINT.md), hashed as they were read.
@@ -140,8 +141,8 @@ cache::CacheHeader ShotRunner::cacheHeader() const {
   const bool rectangle = scene_.sheet.kind == io::SheetSpec::Kind::Rectangle;
   header.sheetWidth = rectangle ? scene_.sheet.width : 0.0;
   header.sheetHeight = rectangle ? scene_.sheet.height : 0.0;
-  header.paperName = scene_.paper.name;
-  header.paperThickness = scene_.paper.thickness;
+  header.paperName = scene_.paper.material.name;
+  header.paperThickness = scene_.paper.material.thickness;
   for (const auto& h : sheet_.rig->handles()) header.handleNames.push_back(h.name);
   header.extensions = lookBlocks_;
   if (sheet_.context->contactsOn)
@@ -235,7 +236,8 @@ void ShotRunner::step(int frame) {
     r.stages[name].frames += 1;
   }
   structureBlock_.reset();
-  if (s.structure) structureBlock_ = cache::encodeStructureChanges(cacheStructureChanges(*s.structure));
+  if (s.structure)
+    structureBlock_ = cache::encodeStructureChanges(cacheStructureChanges(*s.structure));
 }
 
 // The tearing stage (model::TearStage), and the tear textures in the cache.
@@ -336,8 +338,7 @@ std::string ShotRunner::costCause(int frame) const {
 // the cache stays valid up to the last good frame.
 void ShotRunner::fail(const NumericalError& caught, int frame, double frameSeconds) {
   const double budget = guard_.budget();
-  const bool overBudget =
-      budget > 0.0 && frameSeconds >= budget && caught.stage() != "cost guard";
+  const bool overBudget = budget > 0.0 && frameSeconds >= budget && caught.stage() != "cost guard";
   const NumericalError e =
       overBudget ? guard_.budgetError(frame, caught.stage(), costCause(frame)) : caught;
   progress_->finish();

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "crumple/model/sheet_setup.hpp"
 #include "crumple/pipeline/sound.hpp"
 #include "crumple/tear/candidates.hpp"
 #include "json_writer.hpp"
@@ -198,7 +197,7 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
   j.key("vertices").value(r.vertices);
   j.key("triangles").value(r.triangles);
   j.key("substeps_per_frame").value(scene.substeps);
-  const sim::Material paper = model::materialOf(scene.paper);
+  const sim::Material& paper = scene.paper.material;
   j.key("paper").beginObject();
   j.key("preset").value(paper.name);
   j.key("thickness_m").value(paper.thickness);

@@ -27,18 +27,17 @@ struct Sample {
   std::unique_ptr<io::AnimationScene> animation;
   explicit Sample(const std::string& name)
       : scene(io::loadScene(io::resolveScenePath(sourcePath("samples/" + name)))),
-        animation(std::make_unique<io::AnimationScene>(
-            io::AnimationScene::load(scene.animationFile))) {}
+        animation(
+            std::make_unique<io::AnimationScene>(io::AnimationScene::load(scene.animationFile))) {}
   model::ShotSheet setUp() const {
     model::ModelContext c;
-    c.material = model::materialOf(scene.paper);
-    c.sim.gravity = scene.sim.gravity;
-    c.sim.massDamping = scene.sim.massDamping;
+    c.material = scene.paper.material;
+    c.sim = scene.sim;
     c.sim.recoverFailedSteps = true;
     c.fps = scene.fps;
     c.substeps = scene.substeps;
     c.seed = scene.seed;
-    c.tearing = model::tearingParamsOf(scene.tear);
+    c.tearing = scene.tearing;
     return model::setUpSheet(scene, animation.get(), c, scene.frameTime(scene.frameStart));
   }
 };
@@ -54,7 +53,8 @@ TEST(SheetModel, TheSceneChoosesTheModel) {
   EXPECT_FALSE(elastic.model->singularCounts().has_value());
   EXPECT_TRUE(elastic.model->structure().rulings.empty());
   EXPECT_FALSE(elastic.model->remeshes());
-  EXPECT_EQ(elastic.model->mesh().vertexCount(), model::buildSheet(drape.scene, nullptr).vertexCount());
+  EXPECT_EQ(elastic.model->mesh().vertexCount(),
+            model::buildSheet(drape.scene, nullptr).vertexCount());
 
   const Sample fold("cylinder-fold");
   const model::ShotSheet crumpling = fold.setUp();
@@ -68,7 +68,7 @@ TEST(SheetModel, TheSceneChoosesTheModel) {
     EXPECT_LT(static_cast<std::size_t>(h.vertex), crumpling.model->mesh().vertexCount());
   }
   // The crumpling model runs its tears with S_G's cut rules.
-  const tear::TearingParams scene = model::tearingParamsOf(fold.scene.tear);
+  const tear::TearingParams& scene = fold.scene.tearing;
   EXPECT_GT(crumpling.model->tearingParams(scene).minStartAngle, scene.minStartAngle);
   EXPECT_EQ(elastic.model->tearingParams(scene).minStartAngle, scene.minStartAngle);
 }

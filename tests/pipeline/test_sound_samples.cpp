@@ -1,4 +1,4 @@
-// Scene-level tests of the soundtrack (issue 7) on its samples: wiggle
+// Scene-level tests of the soundtrack on its samples: wiggle
 // flaps, a crumpled sheet clacks, slide-on-table rubs while sliding and
 // flaps when its back stands up, the friction's centroid rises as the sheet
 // shrinks (A4 > A5 > A6), a faster tear is louder and crackles more, and
@@ -121,7 +121,7 @@ TEST(SoundSamples, WiggleFlapsAndACrumpledSheetClacs) {
   // and makes 2 crumpling events after 2 s; the census needs a sheet that
   // goes on crumpling, so this shot runs without the limit.
   const CachedEvents crumple = readEvents(simulateSample(
-      "crumple", dir, -1, [](io::SceneSpec& s) { s.model.hybrid.maxEdgeStrain = 0.0; }));
+      "crumple", dir, -1, [](io::SceneSpec& s) { s.crumpling.maxEdgeStrain = 0.0; }));
   const Census w = crumplingCensus(wiggle);
   // The crumple sample while it crumples: from 1 s, when its corners fold
   // and its singular vertices multiply (3 -> 8 over frames 24-28). Without

@@ -1,4 +1,4 @@
-// Scene-level tests of tearing on the samples of issue 6 (tear-straight,
+// Scene-level tests of tearing on its samples (tear-straight,
 // tear-curved, tear-notch): where each tear starts, the path it takes in the
 // pattern against Roman's hyperbolae (thesis 3.3.1, 3.3.5), and the torn
 // sheet itself: the lips' vertices part in 3D, no triangle crosses a lip,
@@ -192,7 +192,7 @@ TEST(TearSamples, ASceneWithoutTearNeverTears) {
   // tear-notch with [tear] enabled = false: the same pulls, no tear, no tearing stage.
   const TempDir dir;
   io::SceneSpec scene = io::loadScene(io::resolveScenePath(sourcePath("samples/tear-notch")));
-  scene.tear.enabled = false;
+  scene.tearEnabled = false;
   scene.frameEnd = 30;
   const auto r = simulate(scene, (dir / "off").string());
   EXPECT_FALSE(r.tearingOn);
@@ -246,7 +246,7 @@ TEST(TearSamples, TearCylinderStartsAtAJunctionPoint) {
   EXPECT_GT(opening, 2e-3);
   EXPECT_GE(detailRatio(r), 1.15);
   // The untorn crumpling model itself reaches 3.2 % in this shot (the
-  // fingers stretch the flattened border; issue 3): a bound against blow-up.
+  // fingers stretch the flattened border): a bound against blow-up.
   EXPECT_LE(torn, 0.04);
 }
 
@@ -267,7 +267,7 @@ TEST(TearSamples, TheCrumplingModelTearsAtAJunctionAndGoesOnCrumpling) {
   const TempDir dir;
   io::SceneSpec scene = io::loadScene(io::resolveScenePath(sourcePath("samples/cylinder-fold")));
   scene.substeps = 2;
-  scene.tear.enabled = true;
+  scene.tearEnabled = true;
   scene.contact.self = io::ContactSpec::Self::Off;
   const auto r = simulate(scene, (dir / "cylinder").string());
   EXPECT_EQ(r.error, "");

@@ -787,60 +787,61 @@ class SceneParser {
     r.allowOnly({"enabled", "resistance", "tip_damage", "speed_m", "texel_mm", "fiber_size_mm",
                  "fiber_octaves", "fiber_anisotropy", "fiber_direction", "detail_blend",
                  "stress_width_mm", "inward_angle_deg", "eps_a", "max_new_per_frame"});
-    TearSpec& t = spec_.tear;
-    t.enabled = r.boolean("enabled").value_or(true);
-    if (auto v = r.number("resistance")) t.resistance = r.requireNonNegative("resistance", *v);
+    spec_.tearEnabled = r.boolean("enabled").value_or(true);
+    tear::TearingParams& t = spec_.tearing;
+    if (auto v = r.number("resistance"))
+      t.griffith.resistance = r.requireNonNegative("resistance", *v);
     if (auto v = r.number("tip_damage")) {
       if (!(*v >= 0.0 && *v <= 1.0)) r.fail("tip_damage", "must be in [0, 1]");
-      t.tipDamage = *v;
+      t.griffith.tipDamage = *v;
     }
-    if (auto v = r.number("speed_m")) t.speed = r.requirePositive("speed_m", *v);
+    if (auto v = r.number("speed_m")) t.griffith.speed = r.requirePositive("speed_m", *v);
     if (auto v = r.number("texel_mm")) {
-      t.texel = r.requirePositive("texel_mm", *v) * 1e-3;
-      if (t.texel < 2e-5) r.fail("texel_mm", "must be at least 0.02 mm");
+      t.fibers.texelSize = r.requirePositive("texel_mm", *v) * 1e-3;
+      if (t.fibers.texelSize < 2e-5) r.fail("texel_mm", "must be at least 0.02 mm");
     }
     if (auto v = r.number("fiber_size_mm"))
-      t.fiberSize = r.requirePositive("fiber_size_mm", *v) * 1e-3;
+      t.fibers.featureSize = r.requirePositive("fiber_size_mm", *v) * 1e-3;
     if (auto v = r.integer("fiber_octaves")) {
       if (*v < 1 || *v > 12) r.fail("fiber_octaves", "must be in [1, 12]");
-      t.fiberOctaves = static_cast<int>(*v);
+      t.fibers.octaves = static_cast<int>(*v);
     }
     if (auto v = r.number("fiber_anisotropy")) {
       if (!(*v >= 1.0)) r.fail("fiber_anisotropy", "must be >= 1 (1 = isotropic)");
-      t.fiberAnisotropy = *v;
+      t.fibers.anisotropy = *v;
     }
     if (auto v = r.vec2("fiber_direction")) {
       if (!(v->norm() > 0.0)) r.fail("fiber_direction", "must not be zero");
-      t.fiberDirection = v->normalized();
+      t.fibers.fiberDirection = v->normalized();
     }
     if (auto v = r.number("detail_blend")) {
       if (!(*v >= 0.0 && *v <= 1.0)) r.fail("detail_blend", "must be in [0, 1]");
-      t.detailBlend = *v;
+      t.detail.blend = *v;
     }
     if (auto v = r.number("stress_width_mm"))
-      t.stressWidth = r.requirePositive("stress_width_mm", *v) * 1e-3;
+      t.detail.stressWidth = r.requirePositive("stress_width_mm", *v) * 1e-3;
     if (auto v = r.number("inward_angle_deg")) {
       if (!(*v >= 0.0 && *v < 180.0)) r.fail("inward_angle_deg", "must be in [0, 180)");
-      t.minInwardAngle = *v * std::numbers::pi / 180.0;
+      t.griffith.minInwardAngle = *v * std::numbers::pi / 180.0;
     }
     if (auto v = r.number("eps_a")) {
       if (!(*v >= 0.0 && *v < std::numbers::pi)) r.fail("eps_a", "must be in [0, pi) (rad)");
-      t.epsA = *v;
+      t.branchAngle = *v;
     }
     if (auto v = r.integer("max_new_per_frame")) {
       if (*v < 0 || *v > 100) r.fail("max_new_per_frame", "must be in [0, 100]");
-      t.maxNewPerFrame = static_cast<int>(*v);
+      t.maxNewTearsPerFrame = static_cast<int>(*v);
     }
   }
 
-  // [sound]: the table's presence enables the sound events (issue 7).
+  // [sound]: the table's presence enables the sound events and the soundtrack.
   void parseSound(const toml::table* table) {
     if (!table) return;
     const TableReader r(*table, "sound", file_);
     r.allowOnly({"enabled", "grid_mm", "curvature_threshold", "a_max", "free_border_radius_cm",
                  "min_slide_mm_s", "listener", "database", "channels", "sample_rate", "format"});
-    SoundSpec& s = spec_.sound;
-    s.enabled = r.boolean("enabled").value_or(true);
+    spec_.soundEnabled = r.boolean("enabled").value_or(true);
+    sound::EventParams& s = spec_.soundEvents;
     if (auto v = r.number("grid_mm")) {
       s.gridSpacing = r.requirePositive("grid_mm", *v) * 1e-3;
       if (s.gridSpacing < 1e-4) r.fail("grid_mm", "must be at least 0.1 mm");
@@ -855,22 +856,23 @@ class SceneParser {
       s.freeBorderRadius = r.requirePositive("free_border_radius_cm", *v) * 1e-2;
     if (auto v = r.number("min_slide_mm_s"))
       s.minSlideSpeed = r.requireNonNegative("min_slide_mm_s", *v) * 1e-3;
-    if (auto v = r.vec3("listener")) s.listener = *v * mpu();
+    SoundtrackSpec& out = spec_.soundtrack;
+    if (auto v = r.vec3("listener")) out.listener = *v * mpu();
     if (auto d = r.string("database")) {
-      s.databaseLine = r.lineOf("database");
-      s.database = resolvePath(*d);
+      out.databaseLine = r.lineOf("database");
+      out.database = resolvePath(*d);
     }
     if (auto v = r.integer("channels")) {
       if (*v != 1 && *v != 2) r.fail("channels", "must be 1 (mono) or 2 (stereo)");
-      s.channels = static_cast<int>(*v);
+      out.channels = static_cast<int>(*v);
     }
     if (auto v = r.integer("sample_rate")) {
       if (*v != 48000 && *v != 44100) r.fail("sample_rate", "must be 48000 or 44100");
-      s.sampleRate = static_cast<int>(*v);
+      out.sampleRate = static_cast<int>(*v);
     }
     if (auto f = r.string("format")) {
       if (*f != "pcm24" && *f != "float") r.fail("format", "must be \"pcm24\" or \"float\"");
-      s.floatSamples = *f == "float";
+      out.floatSamples = *f == "float";
     }
   }
 
@@ -897,7 +899,7 @@ class SceneParser {
     if (!table) return;
     const TableReader r(*table, "sim", file_);
     r.allowOnly({"gravity", "mass_damping", "stiffness_damping", "max_newton_iterations"});
-    SimSpec& s = spec_.sim;
+    sim::SimParams& s = spec_.sim;
     if (auto g = r.vec3("gravity")) {
       if (g->norm() > 1000.0)
         r.fail("gravity", "is implausibly large (m/s^2, not scaled by units)");
@@ -965,7 +967,7 @@ class SceneParser {
       r.fail("type", "unknown model '" + type + "' (expected one of: elastic, hybrid)");
     }
     m.type = ModelSpec::Type::Hybrid;
-    HybridSpec& h = m.hybrid;
+    paper::CrumpleParams& h = spec_.crumpling;
     // value in (lo, hi), or [lo, hi) when loClosed; hiText names hi in the message.
     auto inRange = [&](std::string_view key, double v, double lo, double hi, bool loClosed,
                        const std::string& hiText = {}) {
