@@ -220,7 +220,7 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
   for (const auto& [name, cost] : r.stages) j.key(name).value(cost.msPerFrame());
   j.endObject();
   if (r.contactsOn) {
-    // Issue 5: what contacts cost (detection, penalties' setup and the
+    // What contacts cost (detection, penalties' setup and the
     // failsafe; the Newton iterations they add are the elastic stage's) and
     // the deepest any free vertex went, measured at every frame.
     const double frames = std::max(1, r.framesSimulated - 1);
@@ -238,7 +238,7 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
     j.endObject();
   }
   if (r.soundOn) {
-    // Issue 7: the events in the cache, and the soundtrack `run` made.
+    // The sound events in the cache, and the soundtrack `run` made.
     j.key("sound").beginObject();
     j.key("crumpling_events").value(static_cast<long long>(r.soundEvents[0]));
     j.key("friction_events").value(static_cast<long long>(r.soundEvents[1]));
@@ -250,7 +250,7 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
     j.endObject();
   }
   if (r.tearingOn) {
-    // Issue 6: the tears, where each started and how far it ran.
+    // The tears: where each started and how far it ran.
     const double frames = std::max(1, r.framesSimulated - 1);
     j.key("tearing").beginObject();
     j.key("ms_per_frame").value(r.tearMs / frames);
