@@ -103,7 +103,7 @@ Config hybridAt(const io::SceneSpec& scene, const BenchRow& own, int substeps,
   c.row.role = role;
   c.row.substeps = substeps;
   if (lengthSweeps > 0) {
-    c.scene.model.hybrid.isometryLengthSweeps = lengthSweeps;
+    c.scene.crumpling.isometryLengthSweeps = lengthSweeps;
     c.row.lengthSweeps = lengthSweeps;
   }
   return c;
@@ -140,7 +140,7 @@ double estimateWeight(const io::SceneSpec& s) {
   // The isometry's length sweeps dominate a hybrid step beyond a few
   // thousand (moebius at one substep: 2.4 ms per frame at 300, 40 at 30000).
   const double sweeps = s.model.type == io::ModelSpec::Type::Hybrid
-                            ? static_cast<double>(s.model.hybrid.isometryLengthSweeps)
+                            ? static_cast<double>(s.crumpling.isometryLengthSweeps)
                             : 0.0;
   return frames * s.substeps * triangles * (1.0 + sweeps / 2000.0);
 }
@@ -273,7 +273,7 @@ const CrumplingTarget* crumplingShot(const std::string& sample) {
 
 std::string BenchRow::label() const {
   char text[64];
-  if (model == "hybrid" && lengthSweeps != io::HybridSpec{}.isometryLengthSweeps)
+  if (model == "hybrid" && lengthSweeps != paper::CrumpleParams{}.isometryLengthSweeps)
     std::snprintf(text, sizeof text, "hybrid x%d, %d sweeps", substeps, lengthSweeps);
   else if (model == "hybrid")
     std::snprintf(text, sizeof text, "hybrid x%d", substeps);
@@ -347,7 +347,7 @@ std::vector<BenchRow> runBench(const BenchOptions& options, std::ostream& progre
     own.model = hybrid ? "hybrid" : "elastic";
     own.edgeCm = hybrid ? 0.0 : 100.0 * meshEdge(scene);
     own.substeps = scene.substeps;
-    own.lengthSweeps = hybrid ? scene.model.hybrid.isometryLengthSweeps : 0;
+    own.lengthSweeps = hybrid ? scene.crumpling.isometryLengthSweeps : 0;
     add(Config{scene, own, 1.0});
     if (const CrumplingTarget* shot = crumplingShot(name); hybrid && shot) {
       addCrumplingShot(scene, own, *shot, plan, lastFrame, add);

@@ -60,7 +60,7 @@ void SceneColliders::moveTo(double t) {
 
 sim::ContactOptions contactOptionsOf(const io::SceneSpec& scene, SceneColliders& colliders) {
   sim::ContactOptions o;
-  o.distance = scene.paper.thickness;
+  o.distance = scene.paper.material.thickness;
   if (!colliders.empty()) {
     o.colliders = &colliders.set();
     o.moveColliders = [&colliders](double t) { colliders.moveTo(t); };

@@ -211,7 +211,7 @@ SlurmScripts slurmScripts(const io::SceneSpec& scene, const SlurmOptions& o) {
   s.cachePath = (fs::path(s.outDir) / "cache.pcache").string();
   s.frames = {scene.frameStart, scene.frameEnd};
   s.chunks = frameChunks(s.frames, o.chunk);
-  s.sound = scene.sound.enabled;
+  s.sound = scene.soundEnabled;
   if (!scene.output.frames)
     throw InputError(scene.file,
                      "[output] frames = false: the farm has no frames to render (crumple "

@@ -133,7 +133,7 @@ render::RenderScene makeRenderScene(const io::SceneSpec& scene, const cache::Cam
   view.paper.frontColor = scene.paper.frontColor;
   view.paper.backColor = scene.paper.backColor;
   view.paper.transmittance =
-      scene.look.transmittance.value_or(render::paperTransmittance(scene.paper.thickness));
+      scene.look.transmittance.value_or(render::paperTransmittance(scene.paper.material.thickness));
   view.paper.creaseAngle = scene.look.creaseAngle;
   return view;
 }

@@ -3,24 +3,9 @@
 #include <filesystem>
 
 #include "crumple/core/error.hpp"
-#include "crumple/model/sheet_setup.hpp"
 
 namespace crumple::pipeline {
 namespace fs = std::filesystem;
-
-namespace {
-
-sound::EventParams eventParamsOf(const io::SoundSpec& s) {
-  sound::EventParams p;
-  p.gridSpacing = s.gridSpacing;
-  p.curvatureThreshold = s.curvatureThreshold;
-  p.maxDihedral = s.maxDihedral;
-  p.freeBorderRadius = s.freeBorderRadius;
-  p.minSlideSpeed = s.minSlideSpeed;
-  return p;
-}
-
-}  // namespace
 
 ShotPlan planShot(const io::SceneSpec& scene, const ShotOptions& options) {
   ShotPlan plan;
@@ -49,8 +34,8 @@ ShotPlan planShot(const io::SceneSpec& scene, const ShotOptions& options) {
   plan.substeps = scene.substeps;
   plan.seed = options.seed.value_or(scene.seed);
   plan.crumpling = scene.model.type == io::ModelSpec::Type::Hybrid;
-  plan.tearing = scene.tear.enabled;
-  plan.sound = scene.sound.enabled;
+  plan.tearing = scene.tearEnabled;
+  plan.sound = scene.soundEnabled;
   plan.render = options.render && scene.output.frames;
   if (plan.render) plan.framesDir = (fs::path(plan.outDir) / "frames").string();
   plan.debugStructure = options.debugStructure;
@@ -62,18 +47,15 @@ ShotPlan planShot(const io::SceneSpec& scene, const ShotOptions& options) {
   plan.interactive = options.interactive;
 
   model::ModelContext& m = plan.model;
-  m.material = model::materialOf(scene.paper);
-  m.sim.gravity = scene.sim.gravity;
-  m.sim.massDamping = scene.sim.massDamping;
-  m.sim.stiffnessDamping = scene.sim.stiffnessDamping;
-  m.sim.maxNewtonIterations = scene.sim.maxNewtonIterations;
+  m.material = scene.paper.material;
+  m.sim = scene.sim;
   m.sim.recoverFailedSteps = true;  // before a shot stops on a failed step (docs/STABILITY.md)
   m.fps = scene.fps;
   m.substeps = scene.substeps;
   m.seed = plan.seed;
-  m.tearing = model::tearingParamsOf(scene.tear);
+  m.tearing = scene.tearing;
   m.projectionProbe = options.projectionProbe;
-  plan.soundEvents = eventParamsOf(scene.sound);
+  plan.soundEvents = scene.soundEvents;
   return plan;
 }
 

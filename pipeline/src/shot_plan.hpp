@@ -11,7 +11,7 @@
 #include "crumple/io/scene.hpp"
 #include "crumple/model/sheet_model.hpp"
 #include "crumple/pipeline/shot.hpp"
-#include "crumple/sound/events.hpp"
+#include "crumple/sound/params.hpp"
 
 namespace crumple::pipeline {
 

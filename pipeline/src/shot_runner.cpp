@@ -139,8 +139,8 @@ cache::CacheHeader ShotRunner::cacheHeader() const {
   const bool rectangle = scene_.sheet.kind == io::SheetSpec::Kind::Rectangle;
   header.sheetWidth = rectangle ? scene_.sheet.width : 0.0;
   header.sheetHeight = rectangle ? scene_.sheet.height : 0.0;
-  header.paperName = scene_.paper.name;
-  header.paperThickness = scene_.paper.thickness;
+  header.paperName = scene_.paper.material.name;
+  header.paperThickness = scene_.paper.material.thickness;
   for (const auto& h : sheet_.rig->handles()) header.handleNames.push_back(h.name);
   header.extensions = lookBlocks_;
   if (sheet_.context->contactsOn)

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "crumple/model/sheet_setup.hpp"
 #include "crumple/pipeline/sound.hpp"
 #include "crumple/tear/candidates.hpp"
 #include "json_writer.hpp"
@@ -198,7 +197,7 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
   j.key("vertices").value(r.vertices);
   j.key("triangles").value(r.triangles);
   j.key("substeps_per_frame").value(scene.substeps);
-  const sim::Material paper = model::materialOf(scene.paper);
+  const sim::Material& paper = scene.paper.material;
   j.key("paper").beginObject();
   j.key("preset").value(paper.name);
   j.key("thickness_m").value(paper.thickness);
@@ -240,7 +239,7 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
     j.endObject();
   }
   if (r.soundOn) {
-    // The events in the cache, and the soundtrack `run` made.
+    // The sound events in the cache, and the soundtrack `run` made.
     j.key("sound").beginObject();
     j.key("crumpling_events").value(static_cast<long long>(r.soundEvents[0]));
     j.key("friction_events").value(static_cast<long long>(r.soundEvents[1]));
@@ -252,7 +251,7 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
     j.endObject();
   }
   if (r.tearingOn) {
-    // The tears, where each started and how far it ran.
+    // The tears: where each started and how far it ran.
     const double frames = std::max(1, r.framesSimulated - 1);
     j.key("tearing").beginObject();
     j.key("ms_per_frame").value(r.tearMs / frames);

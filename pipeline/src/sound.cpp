@@ -140,16 +140,16 @@ SoundReport makeSound(const std::string& cachePath, const SoundOptions& options)
       io::parseScene(header.sceneText, header.sceneFile + " (in " + cachePath + ")",
                      fs::path(header.sceneFile).parent_path().string(),
                      /*checkFiles=*/false);
-  report.sampleRate = options.sampleRate.value_or(scene.sound.sampleRate);
+  report.sampleRate = options.sampleRate.value_or(scene.soundtrack.sampleRate);
   if (!sound::supportedSampleRate(report.sampleRate))
     throw InputError("--rate", std::to_string(report.sampleRate) + " Hz: 48000 or 44100");
-  report.channels = options.channels.value_or(scene.sound.channels);
+  report.channels = options.channels.value_or(scene.soundtrack.channels);
   if (report.channels != 1 && report.channels != 2)
     throw InputError("--channels", std::to_string(report.channels) + ": 1 (mono) or 2 (stereo)");
-  const bool floatSamples = options.floatSamples.value_or(scene.sound.floatSamples);
-  report.databasePath = !options.database.empty()       ? options.database
-                        : !scene.sound.database.empty() ? scene.sound.database
-                                                        : defaultSoundDatabase();
+  const bool floatSamples = options.floatSamples.value_or(scene.soundtrack.floatSamples);
+  report.databasePath = !options.database.empty()            ? options.database
+                        : !scene.soundtrack.database.empty() ? scene.soundtrack.database
+                                                             : defaultSoundDatabase();
   report.wavPath = soundPath(cachePath, options.out);
   if (options.gainDb && !(std::abs(*options.gainDb) <= kMaxGainDb))
     throw InputError("--gain-db", "must be a number of dB within +-" + std::to_string(kMaxGainDb));
@@ -167,7 +167,7 @@ SoundReport makeSound(const std::string& cachePath, const SoundOptions& options)
   for (std::size_t i = 0; i < reader.frameCount(); ++i) {
     const cache::FrameRecord record = reader.readFrame(i);
     sound::FrameEvents& f = frames[i];
-    f.listener = scene.sound.listener.value_or(record.camera.position);
+    f.listener = scene.soundtrack.listener.value_or(record.camera.position);
     f.right = record.camera.rotation * Vec3::UnitX();
     if (const auto events = frameEvents(cachePath, record))
       for (const auto& r : *events) {

@@ -56,15 +56,15 @@ TEST(PaperPreset, ShippedPresetsAreConsistent) {
   for (const char* name : {"office-70gsm", "office-90gsm"}) {
     const std::string file = kAssets + "/papers/" + name + ".toml";
     const PaperPreset p = loadPaperPreset(file);
-    EXPECT_EQ(p.name, name);
+    EXPECT_EQ(p.material.name, name);
     EXPECT_EQ(p.file, file);
-    EXPECT_NEAR(p.density, p.grammage / p.thickness, 0.01 * p.density);
-    EXPECT_GT(p.youngsModulus, 1e9);
-    EXPECT_LT(p.youngsModulus, 1e10);
-    EXPECT_GE(p.poissonRatio, 0.2);
-    EXPECT_LE(p.poissonRatio, 0.3);
-    EXPECT_GT(p.thickness, 5e-5);
-    EXPECT_LT(p.thickness, 2e-4);
+    EXPECT_NEAR(p.material.density, p.grammage / p.material.thickness, 0.01 * p.material.density);
+    EXPECT_GT(p.material.youngsModulus, 1e9);
+    EXPECT_LT(p.material.youngsModulus, 1e10);
+    EXPECT_GE(p.material.poissonRatio, 0.2);
+    EXPECT_LE(p.material.poissonRatio, 0.3);
+    EXPECT_GT(p.material.thickness, 5e-5);
+    EXPECT_LT(p.material.thickness, 2e-4);
     // Every number in the file carries a "# source:" comment.
     std::ifstream in(file);
     std::string line, text;
@@ -76,17 +76,17 @@ TEST(PaperPreset, ShippedPresetsAreConsistent) {
   EXPECT_NEAR(p70.grammage, 0.070, 1e-12);
   const PaperPreset p90 = loadPaperPreset(kAssets + "/papers/office-90gsm.toml");
   EXPECT_NEAR(p90.grammage, 0.090, 1e-12);
-  EXPECT_GT(p90.thickness, p70.thickness);
+  EXPECT_GT(p90.material.thickness, p70.material.thickness);
 }
 
 TEST(PaperPreset, GoodFile) {
   TempDir dir;
   const PaperPreset p = loadPaperPreset(dir.write("test-paper.toml", kGood));
   EXPECT_DOUBLE_EQ(p.grammage, 0.080);
-  EXPECT_DOUBLE_EQ(p.thickness, 1.0e-4);
-  EXPECT_DOUBLE_EQ(p.density, 800.0);
-  EXPECT_DOUBLE_EQ(p.youngsModulus, 4.0e9);
-  EXPECT_DOUBLE_EQ(p.poissonRatio, 0.3);
+  EXPECT_DOUBLE_EQ(p.material.thickness, 1.0e-4);
+  EXPECT_DOUBLE_EQ(p.material.density, 800.0);
+  EXPECT_DOUBLE_EQ(p.material.youngsModulus, 4.0e9);
+  EXPECT_DOUBLE_EQ(p.material.poissonRatio, 0.3);
 }
 
 void expectPresetError(const std::string& text, long line, const std::string& key,
@@ -133,10 +133,10 @@ TEST(PaperPreset, EnvironmentDirectoryComesFirst) {
   EXPECT_EQ(dirs[1], kAssets + "/papers");
   const SceneSpec s = parseScene(
       "[sheet]\nwidth = 1\nheight = 1\n[paper]\npreset = \"test-paper\"\n", "t.toml", kData);
-  EXPECT_EQ(s.paper.name, "test-paper");
+  EXPECT_EQ(s.paper.material.name, "test-paper");
   EXPECT_DOUBLE_EQ(s.paper.grammage, 0.080);
   // Shipped presets are still found in the source tree.
-  EXPECT_EQ(parseScene("[sheet]\nwidth = 1\nheight = 1\n", "t.toml", kData).paper.name,
+  EXPECT_EQ(parseScene("[sheet]\nwidth = 1\nheight = 1\n", "t.toml", kData).paper.material.name,
             "office-70gsm");
   ::unsetenv("CRUMPLE_ASSETS");
   EXPECT_EQ(paperPresetDirs().size(), 1u);

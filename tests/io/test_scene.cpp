@@ -6,10 +6,13 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
+#include <numbers>
 #include <optional>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "crumple/core/error.hpp"
@@ -134,7 +137,7 @@ max_newton_iterations = 12
   EXPECT_TRUE(s.sheet.vAxis.isApprox(Vec3(0, 0, -1)));
 
   EXPECT_EQ(s.paperPreset, "office-90gsm");
-  EXPECT_EQ(s.paper.name, "office-90gsm");
+  EXPECT_EQ(s.paper.material.name, "office-90gsm");
   EXPECT_NEAR(s.paper.grammage, 0.090, 1e-12);
   EXPECT_TRUE(s.paper.frontColor.isApprox(Vec3(0.9, 0.8, 0.7)));
   EXPECT_TRUE(s.paper.backColor.isApprox(Vec3(0.5, 0.5, 0.5)));
@@ -197,7 +200,7 @@ TEST(Scene, Defaults) {
   EXPECT_EQ(s.frameEnd, 48);
   EXPECT_EQ(s.substeps, 4);
   EXPECT_TRUE(s.animationFile.empty());
-  EXPECT_EQ(s.paper.name, "office-70gsm");
+  EXPECT_EQ(s.paper.material.name, "office-70gsm");
   EXPECT_TRUE(s.handles.empty());
   EXPECT_FALSE(s.camera.fovExplicit);
   EXPECT_FALSE(s.ground.enabled);
@@ -477,11 +480,11 @@ TEST(SceneModel, ElasticWhenAbsent) {
 }
 
 TEST(SceneModel, HybridDefaultsAreTheSeeds) {
-  // Paper Table VI, thesis 2.3.3; the same numbers as crumple::paper::CrumpleParams.
+  // Paper Table VI, thesis 2.3.3: crumple::paper::CrumpleParams's defaults.
   const SceneSpec s = parse(kSheet + "[model]\ntype = \"hybrid\"\n");
   EXPECT_EQ(s.model.type, ModelSpec::Type::Hybrid);
   EXPECT_EQ(s.model.typeLine, 5);
-  const HybridSpec& h = s.model.hybrid;
+  const paper::CrumpleParams& h = s.crumpling;
   EXPECT_DOUBLE_EQ(h.rhoBound, 120.0);  // 1.2 per cm
   EXPECT_DOUBLE_EQ(h.rhoInt, 3600.0);   // 0.36 per cm^2
   EXPECT_DOUBLE_EQ(h.theta0, 0.01);
@@ -495,10 +498,61 @@ TEST(SceneModel, HybridDefaultsAreTheSeeds) {
   EXPECT_EQ(h.isometryIterations, 200);
   EXPECT_EQ(h.isometryLengthSweeps, 300);
   EXPECT_DOUBLE_EQ(h.isometryLengthTolerance, 1e-6);
-  // A scene without [model] carries the same defaults.
-  const HybridSpec d = parse(kSheet).model.hybrid;
-  EXPECT_DOUBLE_EQ(d.rhoBound, h.rhoBound);
-  EXPECT_DOUBLE_EQ(d.thetaRest, h.thetaRest);
+  // Without keys, and without [model], the scene holds the model's own struct as it is.
+  EXPECT_EQ(h, paper::CrumpleParams{});
+  EXPECT_EQ(parse(kSheet).crumpling, paper::CrumpleParams{});
+}
+
+// Each [model] key reaches its field of paper::CrumpleParams, converted to
+// SI (whatever [scene] units says), and changes nothing else.
+TEST(SceneModel, EveryKeyReachesCrumpleParams) {
+  const std::string head =
+      "[scene]\nunits = \"mm\"\n[sheet]\nwidth = 100\nheight = 100\n[model]\ntype = \"hybrid\"\n";
+  using Set = std::function<void(paper::CrumpleParams&)>;
+  const std::vector<std::pair<std::string, Set>> cases = {
+      {"rho_bound_per_cm = 2.5", [](auto& p) { p.rhoBound = 2.5 * 100.0; }},
+      {"rho_int_per_cm2 = 6", [](auto& p) { p.rhoInt = 6.0 * 1.0e4; }},
+      {"theta0 = 0.02",
+       [](auto& p) {
+         p.theta0 = 0.02;
+         p.thetaLow = 0.02 / 10.0;
+         p.thetaHigh = 0.02;
+       }},
+      {"theta_low = 0.003", [](auto& p) { p.thetaLow = 0.003; }},
+      {"theta_high = 0.015", [](auto& p) { p.thetaHigh = 0.015; }},
+      {"eps_blaschke = 0.01", [](auto& p) { p.epsBlaschke = 0.01; }},
+      {"eps_c = 0.005", [](auto& p) { p.epsC = 0.005; }},
+      {"sigma_cm = 0.3", [](auto& p) { p.sigma = 0.3 * 0.01; }},
+      {"theta_rest = 0.5", [](auto& p) { p.thetaRest = 0.5; }},
+      {"damage = 4", [](auto& p) { p.damage = 4.0; }},
+      {"isometry_iterations = 50", [](auto& p) { p.isometryIterations = 50; }},
+      {"isometry_length_sweeps = 0", [](auto& p) { p.isometryLengthSweeps = 0; }},
+      {"isometry_length_tolerance = 1e-9", [](auto& p) { p.isometryLengthTolerance = 1e-9; }},
+      {"max_singular_per_frame = 5", [](auto& p) { p.maxSingularPerFrame = 5; }},
+      {"remesh_cooldown = 0", [](auto& p) { p.remeshCooldown = 0; }},
+      {"max_edge_strain = 0.01", [](auto& p) { p.maxEdgeStrain = 0.01; }},
+      {"lag_catch_up_speed = 0.05", [](auto& p) { p.lagCatchUpSpeed = 0.05; }},
+  };
+  for (const auto& [line, set] : cases) {
+    paper::CrumpleParams want;
+    set(want);
+    EXPECT_EQ(parse(head + line + "\n").crumpling, want) << line;
+  }
+}
+
+// [sim] fills sim::SimParams: its keys in their fields (m/s^2 never scaled
+// by units), the rest the simulator's defaults.
+TEST(SceneSim, EveryKeyReachesSimParams) {
+  EXPECT_EQ(parse(kSheet).sim, sim::SimParams{});
+  const SceneSpec s = parse("[scene]\nunits = \"cm\"\n" + kSheet +
+                            "[sim]\ngravity = [0, -1.62, 0]\nmass_damping = 0.25\n"
+                            "stiffness_damping = 0.001\nmax_newton_iterations = 12\n");
+  sim::SimParams want;
+  want.gravity = Vec3(0.0, -1.62, 0.0);
+  want.massDamping = 0.25;
+  want.stiffnessDamping = 0.001;
+  want.maxNewtonIterations = 12;
+  EXPECT_EQ(s.sim, want);
 }
 
 TEST(SceneModel, EveryKeyParsedAndConvertedToSI) {
@@ -524,7 +578,7 @@ TEST(SceneModel, EveryKeyParsedAndConvertedToSI) {
       "remesh_cooldown = 0\n"
       "max_edge_strain = 0.02\n"
       "lag_catch_up_speed = 0.05\n");
-  const HybridSpec& h = s.model.hybrid;
+  const paper::CrumpleParams& h = s.crumpling;
   EXPECT_EQ(s.model.type, ModelSpec::Type::Hybrid);
   EXPECT_DOUBLE_EQ(h.rhoBound, 250.0);
   EXPECT_DOUBLE_EQ(h.rhoInt, 60000.0);
@@ -547,16 +601,17 @@ TEST(SceneModel, EveryKeyParsedAndConvertedToSI) {
 
 TEST(SceneModel, HysteresisFollowsTheta0) {
   const std::string head = kSheet + "[model]\ntype = \"hybrid\"\n";
-  const HybridSpec a = parse(head + "theta0 = 0.05\n").model.hybrid;
+  const paper::CrumpleParams a = parse(head + "theta0 = 0.05\n").crumpling;
   EXPECT_DOUBLE_EQ(a.thetaLow, 0.005);
   EXPECT_DOUBLE_EQ(a.thetaHigh, 0.05);
-  const HybridSpec b = parse(head + "theta0 = 0.05\ntheta_low = 0.02\n").model.hybrid;
+  const paper::CrumpleParams b = parse(head + "theta0 = 0.05\ntheta_low = 0.02\n").crumpling;
   EXPECT_DOUBLE_EQ(b.thetaLow, 0.02);
   EXPECT_DOUBLE_EQ(b.thetaHigh, 0.05);
-  const HybridSpec c = parse(head + "theta_high = 0.1\n").model.hybrid;
+  const paper::CrumpleParams c = parse(head + "theta_high = 0.1\n").crumpling;
   EXPECT_DOUBLE_EQ(c.thetaLow, 0.001);
   EXPECT_DOUBLE_EQ(c.thetaHigh, 0.1);
-  const HybridSpec d = parse(head + "theta_rest = 0\ndamage = 0\n").model.hybrid;  // no damage
+  const paper::CrumpleParams d =
+      parse(head + "theta_rest = 0\ndamage = 0\n").crumpling;  // no damage
   EXPECT_DOUBLE_EQ(d.thetaRest, 0.0);
   EXPECT_DOUBLE_EQ(d.damage, 0.0);
 }
@@ -724,19 +779,19 @@ TEST(Samples, PaperTypesDifferOnlyInEpsC) {
   const SceneSpec b = loadScene(dir + "eps-0.5.toml");
   const SceneSpec c = loadScene(dir + "eps-0.2.toml");
   EXPECT_EQ(a.model.type, ModelSpec::Type::Hybrid);
-  EXPECT_DOUBLE_EQ(a.model.hybrid.epsC, 0.01);
-  EXPECT_DOUBLE_EQ(b.model.hybrid.epsC, 0.005);
-  EXPECT_DOUBLE_EQ(c.model.hybrid.epsC, 0.002);
+  EXPECT_DOUBLE_EQ(a.crumpling.epsC, 0.01);
+  EXPECT_DOUBLE_EQ(b.crumpling.epsC, 0.005);
+  EXPECT_DOUBLE_EQ(c.crumpling.epsC, 0.002);
   EXPECT_EQ(a.animationFile, b.animationFile);
   EXPECT_EQ(a.animationFile, c.animationFile);
   EXPECT_EQ(a.handles.size(), c.handles.size());
-  EXPECT_DOUBLE_EQ(a.model.hybrid.sigma, c.model.hybrid.sigma);
+  EXPECT_DOUBLE_EQ(a.crumpling.sigma, c.crumpling.sigma);
 }
 
 }  // namespace
 }  // namespace crumple::io
 
-// --- rendering keys (issue 4) --------------------------------------------------
+// --- rendering keys --------------------------------------------------
 
 namespace crumple::io {
 namespace {
@@ -1086,7 +1141,7 @@ TEST(Scene, SheetOutlineIsAPolygonInSceneUnitsTurnedCounterClockwise) {
   EXPECT_NEAR(area, 0.0085, 1e-12) << "counter-clockwise, in m^2";
   EXPECT_DOUBLE_EQ(s.sheet.width, 0.12);
   EXPECT_DOUBLE_EQ(s.sheet.height, 0.10);
-  EXPECT_FALSE(s.tear.enabled) << "no [tear]: no tearing";
+  EXPECT_FALSE(s.tearEnabled) << "no [tear]: no tearing";
 }
 
 TEST(Scene, BadOutlinesAndTearKeysSayWhatIsWrong) {
@@ -1101,41 +1156,113 @@ TEST(Scene, BadOutlinesAndTearKeysSayWhatIsWrong) {
   expectError(kSheet + "[tear]\nfiber_anisotropy = 0.5\n", 5, "tear.fiber_anisotropy", {">= 1"});
   expectError(kSheet + "[tear]\nspeed = 1\n", 5, "tear.speed", {"unknown key"});
   const SceneSpec off = parse(kSheet + "[tear]\nenabled = false\n");
-  EXPECT_FALSE(off.tear.enabled);
+  EXPECT_FALSE(off.tearEnabled);
   const SceneSpec on = parse(kSheet + "[tear]\nresistance = 0.01\ntexel_mm = 0.5\n");
-  EXPECT_TRUE(on.tear.enabled);
-  EXPECT_DOUBLE_EQ(on.tear.resistance, 0.01);
-  EXPECT_DOUBLE_EQ(on.tear.texel, 5e-4);
-  EXPECT_DOUBLE_EQ(parse(kSheet + "[tear]\neps_a = 0.2\n").tear.epsA, 0.2);
+  EXPECT_TRUE(on.tearEnabled);
+  EXPECT_DOUBLE_EQ(on.tearing.griffith.resistance, 0.01);
+  EXPECT_DOUBLE_EQ(on.tearing.fibers.texelSize, 5e-4);
+  EXPECT_DOUBLE_EQ(parse(kSheet + "[tear]\neps_a = 0.2\n").tearing.branchAngle, 0.2);
   expectError(kSheet + "[tear]\neps_a = 4\n", 5, "tear.eps_a", {"[0, pi)"});
 }
 
 TEST(Scene, TheSoundTableTurnsTheSoundtrackOnAndChecksItsKeys) {
-  EXPECT_FALSE(parse(kSheet).sound.enabled) << "no [sound]: no events";
+  EXPECT_FALSE(parse(kSheet).soundEnabled) << "no [sound]: no events";
   const SceneSpec on = parse("[scene]\nunits = \"cm\"\n" + kSheet +
                              "[sound]\ngrid_mm = 5\ncurvature_threshold = 4\na_max = 0.4\n"
                              "free_border_radius_cm = 50\nmin_slide_mm_s = 2\n"
                              "listener = [0, 100, 200]\ndatabase = \"db\"\nchannels = 1\n"
                              "sample_rate = 44100\nformat = \"float\"\n");
-  EXPECT_TRUE(on.sound.enabled);
-  EXPECT_DOUBLE_EQ(on.sound.gridSpacing, 0.005);
-  EXPECT_DOUBLE_EQ(on.sound.curvatureThreshold, 4.0);
-  EXPECT_DOUBLE_EQ(on.sound.maxDihedral, 0.4);
-  EXPECT_DOUBLE_EQ(on.sound.freeBorderRadius, 0.5);
-  EXPECT_DOUBLE_EQ(on.sound.minSlideSpeed, 0.002);
-  ASSERT_TRUE(on.sound.listener);
-  EXPECT_TRUE(on.sound.listener->isApprox(Vec3(0.0, 1.0, 2.0)));  // scene units: cm
-  EXPECT_NE(on.sound.database.find("db"), std::string::npos);
-  EXPECT_EQ(on.sound.channels, 1);
-  EXPECT_EQ(on.sound.sampleRate, 44100);
-  EXPECT_TRUE(on.sound.floatSamples);
-  EXPECT_FALSE(parse(kSheet + "[sound]\nenabled = false\n").sound.enabled);
+  EXPECT_TRUE(on.soundEnabled);
+  EXPECT_DOUBLE_EQ(on.soundEvents.gridSpacing, 0.005);
+  EXPECT_DOUBLE_EQ(on.soundEvents.curvatureThreshold, 4.0);
+  EXPECT_DOUBLE_EQ(on.soundEvents.maxDihedral, 0.4);
+  EXPECT_DOUBLE_EQ(on.soundEvents.freeBorderRadius, 0.5);
+  EXPECT_DOUBLE_EQ(on.soundEvents.minSlideSpeed, 0.002);
+  ASSERT_TRUE(on.soundtrack.listener);
+  EXPECT_TRUE(on.soundtrack.listener->isApprox(Vec3(0.0, 1.0, 2.0)));  // scene units: cm
+  EXPECT_NE(on.soundtrack.database.find("db"), std::string::npos);
+  EXPECT_EQ(on.soundtrack.channels, 1);
+  EXPECT_EQ(on.soundtrack.sampleRate, 44100);
+  EXPECT_TRUE(on.soundtrack.floatSamples);
+  EXPECT_FALSE(parse(kSheet + "[sound]\nenabled = false\n").soundEnabled);
   expectError(kSheet + "[sound]\nchannels = 3\n", 5, "sound.channels", {"1 (mono) or 2"});
   expectError(kSheet + "[sound]\nsample_rate = 22050\n", 5, "sound.sample_rate", {"48000"});
   expectError(kSheet + "[sound]\nformat = \"mp3\"\n", 5, "sound.format", {"pcm24"});
   expectError(kSheet + "[sound]\na_max = 0\n", 5, "sound.a_max", {"(0, pi)"});
   expectError(kSheet + "[sound]\ngrid_mm = 0.01\n", 5, "sound.grid_mm", {"0.1 mm"});
   expectError(kSheet + "[sound]\nvolume = 1\n", 5, "sound.volume", {"unknown key"});
+}
+
+}  // namespace
+}  // namespace crumple::io
+
+// --- the modules' parameter structs ----------------------------------------
+
+namespace crumple::io {
+namespace {
+
+// Each [tear] key reaches its field of tear::TearingParams, converted to SI,
+// and changes nothing else; without keys the struct is the module's own.
+TEST(SceneTear, EveryKeyReachesTearingParams) {
+  EXPECT_EQ(parse(kSheet).tearing, tear::TearingParams{});
+  EXPECT_EQ(parse(kSheet + "[tear]\n").tearing, tear::TearingParams{});
+  using Set = std::function<void(tear::TearingParams&)>;
+  const std::vector<std::pair<std::string, Set>> cases = {
+      {"resistance = 0.01", [](auto& p) { p.griffith.resistance = 0.01; }},
+      {"tip_damage = 0.25", [](auto& p) { p.griffith.tipDamage = 0.25; }},
+      {"speed_m = 2", [](auto& p) { p.griffith.speed = 2.0; }},
+      {"texel_mm = 0.3", [](auto& p) { p.fibers.texelSize = 0.3 * 1e-3; }},
+      {"fiber_size_mm = 3", [](auto& p) { p.fibers.featureSize = 3.0 * 1e-3; }},
+      {"fiber_octaves = 6", [](auto& p) { p.fibers.octaves = 6; }},
+      {"fiber_anisotropy = 2", [](auto& p) { p.fibers.anisotropy = 2.0; }},
+      {"fiber_direction = [0, 2]", [](auto& p) { p.fibers.fiberDirection = Vec2(0.0, 1.0); }},
+      {"detail_blend = 0.25", [](auto& p) { p.detail.blend = 0.25; }},
+      {"stress_width_mm = 0.75", [](auto& p) { p.detail.stressWidth = 0.75 * 1e-3; }},
+      {"inward_angle_deg = 30",
+       [](auto& p) { p.griffith.minInwardAngle = 30.0 * std::numbers::pi / 180.0; }},
+      {"eps_a = 0.2", [](auto& p) { p.branchAngle = 0.2; }},
+      {"max_new_per_frame = 3", [](auto& p) { p.maxNewTearsPerFrame = 3; }},
+  };
+  for (const auto& [line, set] : cases) {
+    tear::TearingParams want;
+    set(want);
+    const SceneSpec s = parse(kSheet + "[tear]\n" + line + "\n");
+    EXPECT_TRUE(s.tearEnabled) << line;
+    EXPECT_EQ(s.tearing, want) << line;
+  }
+}
+
+// Each of [sound]'s event keys reaches its field of sound::EventParams,
+// converted to SI, and changes nothing else; the soundtrack's own keys
+// (listener, database, channels, sample_rate, format) stay io's.
+TEST(SceneSound, EveryEventKeyReachesEventParams) {
+  EXPECT_EQ(parse(kSheet).soundEvents, sound::EventParams{});
+  const SceneSpec own = parse(kSheet + "[sound]\nchannels = 1\nsample_rate = 44100\n");
+  EXPECT_EQ(own.soundEvents, sound::EventParams{});
+  using Set = std::function<void(sound::EventParams&)>;
+  const std::vector<std::pair<std::string, Set>> cases = {
+      {"grid_mm = 5", [](auto& p) { p.gridSpacing = 5.0 * 1e-3; }},
+      {"curvature_threshold = 4", [](auto& p) { p.curvatureThreshold = 4.0; }},
+      {"a_max = 0.4", [](auto& p) { p.maxDihedral = 0.4; }},
+      {"free_border_radius_cm = 50", [](auto& p) { p.freeBorderRadius = 50.0 * 1e-2; }},
+      {"min_slide_mm_s = 2", [](auto& p) { p.minSlideSpeed = 2.0 * 1e-3; }},
+  };
+  for (const auto& [line, set] : cases) {
+    sound::EventParams want;
+    set(want);
+    EXPECT_EQ(parse(kSheet + "[sound]\n" + line + "\n").soundEvents, want) << line;
+  }
+}
+
+// The [paper] preset is read into sim::Material: the default preset is the
+// simulator's default material, another preset differs.
+TEST(ScenePaper, ThePresetFillsTheMaterial) {
+  EXPECT_EQ(parse(kSheet).paper.material, sim::Material{});
+  const SceneSpec heavy = parse(kSheet + "[paper]\npreset = \"office-90gsm\"\n");
+  EXPECT_EQ(heavy.paper.material.name, "office-90gsm");
+  EXPECT_GT(heavy.paper.material.thickness, sim::Material{}.thickness);
+  EXPECT_NEAR(heavy.paper.material.density * heavy.paper.material.thickness, heavy.paper.grammage,
+              0.01 * heavy.paper.grammage);
 }
 
 }  // namespace

@@ -31,14 +31,13 @@ struct Sample {
             std::make_unique<io::AnimationScene>(io::AnimationScene::load(scene.animationFile))) {}
   model::ShotSheet setUp() const {
     model::ModelContext c;
-    c.material = model::materialOf(scene.paper);
-    c.sim.gravity = scene.sim.gravity;
-    c.sim.massDamping = scene.sim.massDamping;
+    c.material = scene.paper.material;
+    c.sim = scene.sim;
     c.sim.recoverFailedSteps = true;
     c.fps = scene.fps;
     c.substeps = scene.substeps;
     c.seed = scene.seed;
-    c.tearing = model::tearingParamsOf(scene.tear);
+    c.tearing = scene.tearing;
     return model::setUpSheet(scene, animation.get(), c, scene.frameTime(scene.frameStart));
   }
 };
@@ -69,7 +68,7 @@ TEST(SheetModel, TheSceneChoosesTheModel) {
     EXPECT_LT(static_cast<std::size_t>(h.vertex), crumpling.model->mesh().vertexCount());
   }
   // The crumpling model runs its tears with S_G's cut rules.
-  const tear::TearingParams scene = model::tearingParamsOf(fold.scene.tear);
+  const tear::TearingParams& scene = fold.scene.tearing;
   EXPECT_GT(crumpling.model->tearingParams(scene).minStartAngle, scene.minStartAngle);
   EXPECT_EQ(elastic.model->tearingParams(scene).minStartAngle, scene.minStartAngle);
 }

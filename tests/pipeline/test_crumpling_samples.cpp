@@ -19,7 +19,6 @@
 #include "crumple/exporters/pcache.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/io/scene.hpp"
-#include "crumple/paper/params.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/shape_compare.hpp"
 #include "crumple/pipeline/shot.hpp"
@@ -380,29 +379,6 @@ TEST(CrumplingSamples, UnloadKeepsItsSingularVertices) {
       last.singularVertices.size(), weakest, weakestEdge);
 }
 
-// The scene's [model] defaults are the model's (io does not depend on
-// src/paper, so the two are kept equal by hand and checked here).
-TEST(CrumplingSamples, SceneDefaultsAreTheModelsDefaults) {
-  const io::HybridSpec h;
-  const paper::CrumpleParams p;
-  EXPECT_EQ(h.rhoBound, p.rhoBound);
-  EXPECT_EQ(h.rhoInt, p.rhoInt);
-  EXPECT_EQ(h.theta0, p.theta0);
-  EXPECT_EQ(h.thetaLow, p.thetaLow);
-  EXPECT_EQ(h.thetaHigh, p.thetaHigh);
-  EXPECT_EQ(h.epsBlaschke, p.epsBlaschke);
-  EXPECT_EQ(h.epsC, p.epsC);
-  EXPECT_EQ(h.sigma, p.sigma);
-  EXPECT_EQ(h.thetaRest, p.thetaRest);
-  EXPECT_EQ(h.damage, p.damage);
-  EXPECT_EQ(h.isometryIterations, p.isometryIterations);
-  EXPECT_EQ(h.isometryLengthSweeps, p.isometryLengthSweeps);
-  EXPECT_EQ(h.isometryLengthTolerance, p.isometryLengthTolerance);
-  EXPECT_EQ(h.maxSingularPerFrame, p.maxSingularPerFrame);
-  EXPECT_EQ(h.remeshCooldown, p.remeshCooldown);
-  EXPECT_EQ(h.maxEdgeStrain, p.maxEdgeStrain);
-}
-
 // `[model] isometry_length_sweeps` reaches the isometry projection and buys
 // length accuracy (docs/BENCH.md: the hybrid model's accuracy knob): on
 // first-singularity at one substep, c_mean over the whole shot: none (the
@@ -414,10 +390,10 @@ TEST(CrumplingSamples, MoreLengthSweepsKeepLengthsBetter) {
         "first-singularity", 96, std::nullopt, dir,
         [&](io::SceneSpec& s) {
           s.substeps = 1;
-          s.model.hybrid.isometryLengthSweeps = sweeps;
+          s.crumpling.isometryLengthSweeps = sweeps;
           // The projection's knob alone: the strain limit would bound
           // what the sweeps leave (0 sweeps: 0.042 % with it on).
-          s.model.hybrid.maxEdgeStrain = 0.0;
+          s.crumpling.maxEdgeStrain = 0.0;
         },
         std::to_string(sweeps));
     EXPECT_EQ(shot.error, "") << sweeps << " sweeps";
@@ -452,7 +428,7 @@ TEST(CrumplingSamples, MoebiusStaysIsometric) {
   EXPECT_LE(worstCMean, 0.002);
   EXPECT_LE(worstNComp, 0.02);
   EXPECT_EQ(interiorSingular, 0u);  // paper Table V: none
-  // The issue also asks for dihedral angles below 0.3 rad between adjacent
+  // The acceptance also asks for dihedral angles below 0.3 rad between adjacent
   // S_P triangles; the band still bends by up to ~1.4 rad across single
   // rulings (docs/CRUMPLING.md, status): recorded only.
   ::testing::Test::RecordProperty("worst_c_mean", std::to_string(worstCMean));
@@ -465,8 +441,8 @@ TEST(CrumplingSamples, MoebiusStaysIsometric) {
 
 // paper Fig. 22 second row: the crumple sample runs to its end with finite
 // positions, a valid pattern triangulation (no inverted triangle), S_P
-// under 400 triangles and no edge through another layer. The issue asks for at least 20 singular
-// vertices; the model reaches 11-16 over seeds 1-6 (docs/CRUMPLING.md): recorded.
+// under 400 triangles and no edge through another layer. The acceptance asks for at least 20
+// singular vertices; the model reaches 11-16 over seeds 1-6 (docs/CRUMPLING.md): recorded.
 TEST(CrumplingSamples, CrumpleRunsToTheEndWithACoarseValidMesh) {
   TempDir dir;
   const Shot shot = simulate("crumple", 108, std::nullopt, dir);

@@ -146,11 +146,7 @@ TEST(Shot, SheetHungByTwoCornersComesToRest) {
   // under gravity, comes to rest (kinetic energy < 1e-9 J) with max membrane
   // strain under 1%.
   const auto preset = io::loadPaperPreset(sourcePath("assets/papers/office-70gsm.toml"));
-  sim::Material material;
-  material.thickness = preset.thickness;
-  material.density = preset.density;
-  material.youngsModulus = preset.youngsModulus;
-  material.poissonRatio = preset.poissonRatio;
+  const sim::Material& material = preset.material;
   auto sheet = mesh::makeRectangleSheet(0.21, 0.297, 0.021);
   mesh::placePattern(sheet, Vec3(0, 0, 0), Vec3::UnitX(), -Vec3::UnitY());  // hangs down from y = 0
   sim::SimParams params;
@@ -377,17 +373,13 @@ TEST(Shot, CameraFromTheAnimationFileIsCachedPerFrame) {
 TEST(PaperPreset, SimulatorDefaultsAreThe70gsmPreset) {
   const auto preset = io::loadPaperPreset(sourcePath("assets/papers/office-70gsm.toml"));
   const sim::Material defaults;
-  EXPECT_EQ(defaults.name, preset.name);
-  EXPECT_DOUBLE_EQ(defaults.thickness, preset.thickness);
-  EXPECT_DOUBLE_EQ(defaults.density, preset.density);
-  EXPECT_DOUBLE_EQ(defaults.youngsModulus, preset.youngsModulus);
-  EXPECT_DOUBLE_EQ(defaults.poissonRatio, preset.poissonRatio);
+  EXPECT_EQ(defaults, preset.material);
   // Derived stiffnesses of the preset (Kirchhoff-Love plate).
   EXPECT_NEAR(defaults.stretchStiffness(), 4.0e9 * 9.0e-5 / (1 - 0.0625), 1e-6);
   EXPECT_NEAR(defaults.bendingStiffness(), 4.0e9 * 7.29e-13 / (12 * (1 - 0.0625)), 1e-12);
   // The 90 g/m^2 preset is thicker and stiffer in bending.
   const auto heavy = io::loadPaperPreset(sourcePath("assets/papers/office-90gsm.toml"));
-  EXPECT_GT(heavy.thickness, preset.thickness);
+  EXPECT_GT(heavy.material.thickness, preset.material.thickness);
   EXPECT_GT(heavy.grammage, preset.grammage);
 }
 

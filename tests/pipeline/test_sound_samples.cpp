@@ -121,7 +121,7 @@ TEST(SoundSamples, WiggleFlapsAndACrumpledSheetClacs) {
   // and makes 2 crumpling events after 2 s; the census needs a sheet that
   // goes on crumpling, so this shot runs without the limit.
   const CachedEvents crumple = readEvents(simulateSample(
-      "crumple", dir, -1, [](io::SceneSpec& s) { s.model.hybrid.maxEdgeStrain = 0.0; }));
+      "crumple", dir, -1, [](io::SceneSpec& s) { s.crumpling.maxEdgeStrain = 0.0; }));
   const Census w = crumplingCensus(wiggle);
   // The crumple sample while it crumples: from 1 s, when its corners fold
   // and its singular vertices multiply (3 -> 8 over frames 24-28). Without

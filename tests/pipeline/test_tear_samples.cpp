@@ -192,7 +192,7 @@ TEST(TearSamples, ASceneWithoutTearNeverTears) {
   // tear-notch with [tear] enabled = false: the same pulls, no tear, no tearing stage.
   const TempDir dir;
   io::SceneSpec scene = io::loadScene(io::resolveScenePath(sourcePath("samples/tear-notch")));
-  scene.tear.enabled = false;
+  scene.tearEnabled = false;
   scene.frameEnd = 30;
   const auto r = simulate(scene, (dir / "off").string());
   EXPECT_FALSE(r.tearingOn);
@@ -267,7 +267,7 @@ TEST(TearSamples, TheCrumplingModelTearsAtAJunctionAndGoesOnCrumpling) {
   const TempDir dir;
   io::SceneSpec scene = io::loadScene(io::resolveScenePath(sourcePath("samples/cylinder-fold")));
   scene.substeps = 2;
-  scene.tear.enabled = true;
+  scene.tearEnabled = true;
   scene.contact.self = io::ContactSpec::Self::Off;
   const auto r = simulate(scene, (dir / "cylinder").string());
   EXPECT_EQ(r.error, "");

@@ -125,7 +125,7 @@ TEST(HandleReach, TheMovingHandleStopsOnTheSheetsReachUnlessItMayTear) {
     EXPECT_EQ(pins[1].position, rig.target(1, t0));
     EXPECT_EQ(rig.reachExcess(1, t0), 0.0);
   }
-  scene.tear.enabled = true;
+  scene.tearEnabled = true;
   const model::HandleRig tearing(scene, &anim, sheet, t0);
   std::vector<sim::Pin> pins;
   tearing.pins(t, pins);

@@ -1,4 +1,5 @@
-// Paper presets (assets/papers/<name>.toml): raw physical numbers in SI.
+// Paper presets (assets/papers/<name>.toml): raw physical numbers in SI,
+// read into sim::Material.
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -49,29 +50,30 @@ PaperPreset loadPaperPreset(const std::string& path) {
                "poisson_ratio", "front_color", "back_color"});
 
   PaperPreset p;
+  sim::Material& m = p.material;
   p.file = path;
   const std::string stem = std::filesystem::path(path).stem().string();
-  p.name = r.string("name").value_or(stem);
-  if (r.has("name") && p.name != stem) {
-    r.fail("name", "preset name '" + p.name + "' does not match its file name '" + stem + ".toml'");
+  m.name = r.string("name").value_or(stem);
+  if (r.has("name") && m.name != stem) {
+    r.fail("name", "preset name '" + m.name + "' does not match its file name '" + stem + ".toml'");
   }
   (void)r.string("description");
 
   p.grammage = readInRange(r, "grammage", kGrammage);
-  p.thickness = readInRange(r, "thickness", kThickness);
-  p.density = readInRange(r, "density", kDensity);
-  const double derived = p.grammage / p.thickness;
-  if (std::abs(p.density - derived) > 0.01 * derived) {
+  m.thickness = readInRange(r, "thickness", kThickness);
+  m.density = readInRange(r, "density", kDensity);
+  const double derived = p.grammage / m.thickness;
+  if (std::abs(m.density - derived) > 0.01 * derived) {
     r.fail("density", "must equal grammage / thickness = " + formatNumber(derived) +
-                          " kg/m^3 within 1% (got " + formatNumber(p.density) + ")");
+                          " kg/m^3 within 1% (got " + formatNumber(m.density) + ")");
   }
-  p.youngsModulus = readInRange(r, "youngs_modulus", kYoungs);
+  m.youngsModulus = readInRange(r, "youngs_modulus", kYoungs);
   const std::optional<double> nu = r.number("poisson_ratio");
   if (!nu) r.missing("poisson_ratio");
   if (!(*nu >= 0.0 && *nu < 0.5)) {
     r.fail("poisson_ratio", "must be in [0, 0.5) (got " + formatNumber(*nu) + ")");
   }
-  p.poissonRatio = *nu;
+  m.poissonRatio = *nu;
   if (auto c = r.vec3("front_color")) p.frontColor = r.requireColor("front_color", *c, 1.0);
   if (auto c = r.vec3("back_color")) p.backColor = r.requireColor("back_color", *c, 1.0);
   return p;

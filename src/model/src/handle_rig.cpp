@@ -164,7 +164,7 @@ HandleRig::HandleRig(const io::SceneSpec& scene, const io::AnimationScene* anima
     bindTargets_.push_back(pose.position);
     bindPattern_.push_back(spec.patternPoint.value_or(sheet.pattern[vertex]));
   }
-  reachLimit_ = scene.sheet.kind == io::SheetSpec::Kind::Rectangle && !scene.tear.enabled;
+  reachLimit_ = scene.sheet.kind == io::SheetSpec::Kind::Rectangle && !scene.tearEnabled;
 }
 
 Vec3 HandleRig::target(std::size_t handle, double t) const {

@@ -17,27 +17,11 @@ namespace crumple::model {
 
 namespace {
 
-paper::CrumpleParams crumpleParamsOf(const io::HybridSpec& h) {
-  paper::CrumpleParams p;
-  p.rhoBound = h.rhoBound;
-  p.rhoInt = h.rhoInt;
-  p.theta0 = h.theta0;
-  p.thetaLow = h.thetaLow;
-  p.thetaHigh = h.thetaHigh;
-  p.epsBlaschke = h.epsBlaschke;
-  p.epsC = h.epsC;
-  p.sigma = h.sigma;
-  p.thetaRest = h.thetaRest;
-  p.damage = h.damage;
-  p.isometryIterations = h.isometryIterations;
-  p.isometryLengthSweeps = h.isometryLengthSweeps;
-  p.isometryLengthTolerance = h.isometryLengthTolerance;
-  p.maxSingularPerFrame = h.maxSingularPerFrame;
-  p.remeshCooldown = h.remeshCooldown;
-  p.maxEdgeStrain = h.maxEdgeStrain;
-  p.lagCatchUpSpeed = h.lagCatchUpSpeed;
-  // Region invariants after every geometric step: always in debug builds,
-  // on request (--debug invariants) in release builds.
+// The scene's crumpling parameters, with the region invariants checked after
+// every geometric step: always in debug builds, on request (--debug
+// invariants) in release builds.
+paper::CrumpleParams crumpleParamsOf(const io::SceneSpec& scene) {
+  paper::CrumpleParams p = scene.crumpling;
   if (debugOptions().invariants) p.checkInvariants = true;
   return p;
 }
@@ -131,34 +115,6 @@ mesh::SheetMesh buildSheet(const io::SceneSpec& scene, const io::AnimationScene*
   return importedSheet(scene, animation);
 }
 
-sim::Material materialOf(const io::PaperPreset& paper) {
-  sim::Material m;
-  m.name = paper.name;
-  m.thickness = paper.thickness;
-  m.density = paper.density;
-  m.youngsModulus = paper.youngsModulus;
-  m.poissonRatio = paper.poissonRatio;
-  return m;
-}
-
-tear::TearingParams tearingParamsOf(const io::TearSpec& t) {
-  tear::TearingParams p;
-  p.griffith.resistance = t.resistance;
-  p.griffith.tipDamage = t.tipDamage;
-  p.griffith.speed = t.speed;
-  p.griffith.minInwardAngle = t.minInwardAngle;
-  p.fibers.texelSize = t.texel;
-  p.fibers.featureSize = t.fiberSize;
-  p.fibers.octaves = t.fiberOctaves;
-  p.fibers.anisotropy = t.fiberAnisotropy;
-  p.fibers.fiberDirection = t.fiberDirection;
-  p.detail.blend = t.detailBlend;
-  p.detail.stressWidth = t.stressWidth;
-  p.maxNewTearsPerFrame = t.maxNewPerFrame;
-  p.branchAngle = t.epsA;
-  return p;
-}
-
 ShotSheet setUpSheet(const io::SceneSpec& scene, const io::AnimationScene* animation,
                      ModelContext context, double t0) {
   context.elasticMesh = [&scene, animation] { return buildSheet(scene, animation); };
@@ -167,7 +123,7 @@ ShotSheet setUpSheet(const io::SceneSpec& scene, const io::AnimationScene* anima
   if (scene.model.type == io::ModelSpec::Type::Hybrid) {
     auto sheet = std::make_unique<paper::HybridSheet>(
         crumplingStartSheet(scene, animation, t0).mesh, out.context->material, out.context->sim,
-        crumpleParamsOf(scene.model.hybrid), out.context->seed);
+        crumpleParamsOf(scene), out.context->seed);
     out.rig = std::make_unique<HandleRig>(scene, animation, sheet->physical().mesh, t0);
     auto crumpling = std::make_unique<CrumplingModel>(std::move(sheet), out.context);
     crumpling->bind(*out.rig, t0);

@@ -3,6 +3,11 @@
 // All lengths are converted to metres on parse (scene `units`), angles to
 // radians. Unknown keys and bad values throw crumple::InputError naming the
 // file, the line and the key (DESIGN.md "Invariants").
+// The simulation's parameters are parsed straight into the modules' own
+// structs (sim::SimParams, sim::Material, paper::CrumpleParams,
+// tear::TearingParams, sound::EventParams: header-only, their defaults
+// written once there); what is io's own (where things are, what runs, what
+// is rendered and written) is declared here.
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -11,19 +16,23 @@
 #include <vector>
 
 #include "crumple/core/types.hpp"
+#include "crumple/paper/params.hpp"
+#include "crumple/sim/material.hpp"
+#include "crumple/sim/params.hpp"
+#include "crumple/sound/params.hpp"
+#include "crumple/tear/params.hpp"
 
 namespace crumple::io {
 
-// A paper material preset (assets/papers/*.toml). Raw physical numbers; the
-// simulator derives stretch and bending stiffness from them.
+// A paper material preset (assets/papers/*.toml): the material the
+// simulator runs (raw physical numbers; it derives stretch and bending
+// stiffness from them) and what the preset adds to it.
 struct PaperPreset {
-  std::string name;            // e.g. "office-70gsm"
-  std::string file;            // where it was read from
-  double grammage = 0.0;       // kg/m^2
-  double thickness = 0.0;      // m
-  double density = 0.0;        // kg/m^3 (grammage / thickness)
-  double youngsModulus = 0.0;  // Pa
-  double poissonRatio = 0.0;
+  // name (e.g. "office-70gsm"), thickness (m), density (kg/m^3, grammage /
+  // thickness), Young's modulus (Pa), Poisson ratio
+  sim::Material material;
+  std::string file;                   // where it was read from
+  double grammage = 0.0;              // kg/m^2
   Vec3 frontColor{0.92, 0.92, 0.90};  // linear RGB albedo of the printed side
   Vec3 backColor{0.92, 0.92, 0.90};
 };
@@ -124,7 +133,7 @@ struct PropSpec {
   Vec3 color{0.6, 0.6, 0.6};
 };
 
-// A collider the sheet must stay outside of (issue 5). Plane: the solid half
+// A collider the sheet must stay outside of (docs/CONTACTS.md). Plane: the solid half
 // below `position` along -normal; box: centred on `position`, axis-aligned
 // (without a node); sphere: centred on `position`; mesh: the triangles of an
 // animation-file node, moving with the node.
@@ -151,7 +160,7 @@ struct ColliderSpec {
   long nodeLine = 0;  // scene file line of `node` (for errors)
 };
 
-// [contact]: how the sheet meets itself (issue 5).
+// [contact]: how the sheet meets itself (docs/CONTACTS.md).
 struct ContactSpec {
   // Self-contact of the sheet. Auto: tested only while the sheet is folded
   // (its triangle normals spread more than 60 degrees from their mean); On:
@@ -160,43 +169,16 @@ struct ContactSpec {
   Self self = Self::Auto;
 };
 
-// [tear]: tearing (issue 6; thesis 3.3). Off unless the table is present
-// (or enabled = true). Lengths have fixed units (their key names say which).
-struct TearSpec {
-  bool enabled = false;
-  // C: E_f = C T_fibers d_p, with E_r in units of the paper's stretch
-  // stiffness times the mesh's edge length (strain-like; tear::TearParams).
-  double resistance = 0.005;
-  double tipDamage = 0.5;   // D in [0, 1]: d_p at a tear's tip
-  double speed = 1.0;       // V (m per unit E_r): the tip advances V E_r per frame
-  double texel = 2.5e-4;    // m: fiber texture and tear-texture resolution
-  double fiberSize = 2e-3;  // m: the fibers' largest noise wavelength
-  int fiberOctaves = 4;
-  double fiberAnisotropy = 1.0;  // >= 1: fibers this much longer along fiber_direction
-  Vec2 fiberDirection = Vec2::UnitX();
-  double detailBlend = 0.5;     // p in thesis eq. (3.2)
-  double stressWidth = 0.5e-3;  // m: G_t's standard deviation
-  double minInwardAngle = 0.1;  // rad: inward corners sharper than pi + this are candidates
-  int maxNewPerFrame = 1;       // tears that may start in one frame
-  double epsA = 0.1;  // rad: a tear turning more at a former tip may branch there (Fig. 3.20)
-};
-
-// [sound]: the soundtrack (issue 7; thesis Chapter 4). Off unless the table
-// is present (or enabled = true): `simulate` then detects the sound events
-// and stores them in the cache, `run` also writes sound.wav.
-struct SoundSpec {
-  bool enabled = false;
-  double gridSpacing = 0.01;        // m (grid_mm): the curvature grid's step (Fig. 4.10)
-  double curvatureThreshold = 3.0;  // 1/m: |H_t - H_{t-1}| of a crumpling event's grid points
-  double maxDihedral = 0.5;         // a_max (rad): a ridge stops vibrations (4.3.2)
-  double freeBorderRadius = 1.0;    // m (free_border_radius_cm): bent more, a border is free
-  double minSlideSpeed = 0.01;      // m/s (min_slide_mm_s): slower contacts are silent
-  std::optional<Vec3> listener;     // world (m); default: the camera
-  std::string database;             // sound database folder, resolved; empty: the default
-  long databaseLine = 0;            // scene file line of `database` (for errors)
-  int channels = 2;                 // 1 or 2
-  int sampleRate = 48000;           // 48000 or 44100
-  bool floatSamples = false;        // 32-bit float instead of 24-bit PCM
+// [sound]'s own keys: where the soundtrack is heard from, the sound
+// database and the WAV file's format (the events' keys fill
+// sound::EventParams).
+struct SoundtrackSpec {
+  std::optional<Vec3> listener;  // world (m); default: the camera
+  std::string database;          // sound database folder, resolved; empty: the default
+  long databaseLine = 0;         // scene file line of `database` (for errors)
+  int channels = 2;              // 1 or 2
+  int sampleRate = 48000;        // 48000 or 44100
+  bool floatSamples = false;     // 32-bit float instead of 24-bit PCM
 };
 
 struct GroundSpec {
@@ -211,44 +193,12 @@ struct OutputSpec {
   bool frames = true;
 };
 
-struct SimSpec {
-  Vec3 gravity{0.0, -9.81, 0.0};  // m/s^2, world is Y-up
-  double massDamping = 0.5;       // 1/s, Rayleigh alpha
-  double stiffnessDamping = 0.0;  // s, Rayleigh beta
-  int maxNewtonIterations = 30;
-};
-
-// Parameters of the hybrid crumpling model (paper Table VI; thesis 2.3.3),
-// in SI units. The defaults equal crumple::paper::CrumpleParams
-// (src/paper/include/crumple/paper/params.hpp); io does not depend on
-// src/paper, so the pipeline copies these fields over.
-struct HybridSpec {
-  double rhoBound = 120.0;     // boundary samples per m (1.2 per cm)
-  double rhoInt = 3600.0;      // interior samples per m^2 (0.36 per cm^2, see params.hpp)
-  double theta0 = 0.01;        // rad, coplanarity threshold
-  double thetaLow = 0.001;     // rad, junction hysteresis (theta0 / 10)
-  double thetaHigh = 0.01;     // rad, junction hysteresis (theta0)
-  double epsBlaschke = 0.005;  // cone-fit tolerance, fraction of L_paper
-  double epsC = 0.001;         // compression threshold, fraction (0.1 %)
-  double sigma = 0.001;        // m, singular-vertex position spread (0.1 cm)
-  double thetaRest = 0.39269908169872414;  // rad, pi / 8 (thesis eq. 2.1)
-  double damage = 10.0;                    // fiber damage D (thesis eq. 2.2)
-  int isometryIterations = 200;            // Phase I iteration cap (paper Sec. 6.3)
-  int isometryLengthSweeps = 300;          // length sweeps after Phase II (our extension)
-  double isometryLengthTolerance = 1e-6;   // their early exit: worst relative edge error
-  int maxSingularPerFrame = 2;             // new singular vertices per frame at most
-  int remeshCooldown = 3;                  // animation steps a remeshed region waits
-  double maxEdgeStrain = 0.02;             // S_P's strain bound after every step (0: off)
-  double lagCatchUpSpeed = 0.02;           // m/s a lagging handle closes its lag at most
-};
-
 struct ModelSpec {
   // Elastic: plain FEM on the fixed [sheet] mesh. Hybrid: the crumpling model
   // of Schreck et al. 2015 (flat/curved regions, singular vertices).
   enum class Type { Elastic, Hybrid };
   Type type = Type::Elastic;  // default when the scene has no [model] table
   long typeLine = 0;          // scene file line of `type` (or [model]), 0 = absent (for errors)
-  HybridSpec hybrid;          // meaningful for Type::Hybrid only
 };
 
 struct SceneSpec {
@@ -267,7 +217,8 @@ struct SceneSpec {
   // shot's own frame times; 0: the cost guard is off.
   std::optional<double> frameBudget;
   SheetSpec sheet;
-  std::string paperPreset = "office-70gsm";
+  // [paper] preset; by default the preset whose numbers are sim::Material's.
+  std::string paperPreset = sim::Material{}.name;
   PaperPreset paper;  // resolved preset
   std::vector<HandleSpec> handles;
   CameraSpec camera;
@@ -283,11 +234,24 @@ struct SceneSpec {
   // unless the scene overrides them; the scene may add more ("wood", ...).
   std::map<std::string, double> friction;
   ContactSpec contact;  // [contact]
-  TearSpec tear;        // [tear]
-  SoundSpec sound;      // [sound]
+  // [tear]: tearing (thesis 3.3; docs/TEARING.md). Off unless the table is
+  // present (or enabled = true). Lengths have fixed units (their key names
+  // say which).
+  bool tearEnabled = false;
+  tear::TearingParams tearing;
+  // [sound]: the soundtrack (thesis Chapter 4; docs/SOUND.md). Off unless
+  // the table is present (or enabled = true): `simulate` then detects the
+  // sound events and stores them in the cache, `run` also writes sound.wav.
+  bool soundEnabled = false;
+  sound::EventParams soundEvents;
+  SoundtrackSpec soundtrack;
   OutputSpec output;
-  SimSpec sim;
-  ModelSpec model;
+  sim::SimParams sim;  // [sim]: gravity, damping, Newton iterations
+  ModelSpec model;     // [model] type
+  // [model]'s parameters of the hybrid crumpling model (paper Table VI;
+  // thesis 2.3.3), in SI units whatever [scene] units says; meaningful for
+  // ModelSpec::Type::Hybrid only.
+  paper::CrumpleParams crumpling;
   std::string sourceText;  // the scene file's text, kept for the cache header
 
   // Animation time (s) of frame `frame`: frame / fps, the DCC convention

@@ -17,12 +17,6 @@ namespace crumple::model {
 // InputError naming the scene file.
 mesh::SheetMesh buildSheet(const io::SceneSpec& scene, const io::AnimationScene* animation);
 
-// The paper preset as the FEM's material.
-sim::Material materialOf(const io::PaperPreset& paper);
-
-// The scene's [tear] as the tear module's parameters.
-tear::TearingParams tearingParamsOf(const io::TearSpec& spec);
-
 // The model of a shot and the rig holding it, bound at time t0 (the first
 // frame): the rig's pins moved onto their nodes.
 struct ShotSheet {

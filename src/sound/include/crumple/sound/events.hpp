@@ -1,6 +1,6 @@
 #pragma once
-// Sound-source events and their resonators (thesis 4.3.2; issue 7, items
-// 1-2). Every simulated frame, the sheet is searched for
+// Sound-source events and their resonators (thesis 4.3.2; docs/SOUND.md).
+// Every simulated frame, the sheet is searched for
 // - crumpling events: connected patches of a regular grid, laid on the
 //   pattern and carried onto the surface (Fig. 4.10), whose mean curvature
 //   changed sign by more than a threshold since the previous frame;
@@ -21,28 +21,9 @@
 #include "crumple/core/state_io.hpp"
 #include "crumple/core/types.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
+#include "crumple/sound/params.hpp"
 
 namespace crumple::sound {
-
-struct EventParams {
-  double gridSpacing = 0.01;  // m: the curvature grid's step in the pattern (Fig. 4.10)
-  // Grids larger than this many points get a larger step (a poster).
-  int maxGridPoints = 40000;
-  // The curvature change |H_t - H_{t-1}| (1/m) a grid point must exceed
-  // (thesis 4.3.2's threshold against small instabilities).
-  double curvatureThreshold = 3.0;
-  double maxDihedral = 0.5;  // a_max (rad): a ridge stops vibrations (thesis 4.3.2)
-  // A sheet border bent along its length to a radius below this (m), and
-  // neither held nor touching, is a free curved border (Fig. 4.8): a
-  // curved region's borders across its rulings, not its straight ends.
-  double freeBorderRadius = 1.0;
-  // A resonator whose free borders add up to less than this (m) has none
-  // that can carry a flap: it is constrained (l_c = 0). Half the database
-  // grid's first step (2.5 cm).
-  double minFreeBorder = 0.0125;
-  double minSlideSpeed = 0.01;  // m/s: slower contacts make no friction event
-  double maxTearGap = 0.5;      // s: a tear idle longer than this had stopped
-};
 
 // A resonator (thesis 4.3.2-4.3.4): its size parameters, and the disk that
 // radiates its sound (a dipole at its centre, along its mean normal, of its
@@ -122,7 +103,7 @@ class EventDetector {
   // row from the pattern's lower left; nullopt where it is undefined (off
   // the sheet, across a tear, at its border).
   const std::vector<std::optional<double>>& curvature() const { return previous_; }
-  // Checkpoint and resume (issue 8): the grid and its last curvatures, and
+  // Checkpoint and resume (docs/CHECKPOINT.md): the grid and its last curvatures, and
   // each tear's last advance. restoreState throws CorruptDataError for a
   // malformed state.
   void saveState(StateWriter& out) const;

@@ -10,19 +10,9 @@
 
 #include "crumple/core/types.hpp"
 #include "crumple/tear/fiber_texture.hpp"
+#include "crumple/tear/params.hpp"
 
 namespace crumple::tear {
-
-// The thesis gives no defaults for p and G_t's width. The greedy walk is
-// bimodal: it either hugs the segment (an 8-neighbour staircase, 1.10-1.15
-// times the straight length) or wanders into the fibers' noise. With the
-// default fiber texture, p = 0.5 and a 0.5 mm width give 1.63-2.63 times
-// the straight length over seeds 1-4 (2 cm segments in 8 directions);
-// p = 0.6 gives 1.14-1.92, p = 0.5 with 0.35 mm 1.12-1.14.
-struct DetailPathParams {
-  double blend = 0.5;           // p in eq. (3.2): 0 = fibers only, 1 = straight
-  double stressWidth = 0.5e-3;  // m: the Gaussian G_t's standard deviation
-};
 
 // nu_t at pattern point q for the segment [from, to] (eq. (3.2)).
 double breakingCoefficient(const FiberTexture& fibers, const Vec2& q, const Vec2& from,

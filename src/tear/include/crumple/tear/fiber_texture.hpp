@@ -9,20 +9,9 @@
 #include <vector>
 
 #include "crumple/core/types.hpp"
+#include "crumple/tear/params.hpp"
 
 namespace crumple::tear {
-
-struct FiberTextureParams {
-  double texelSize = 2.5e-4;    // m per texel: the resolution of the tears' detail
-  double featureSize = 2.0e-3;  // m: the largest noise wavelength (first octave)
-  int octaves = 4;              // each halves the wavelength
-  double persistence = 0.5;     // amplitude ratio between octaves
-  // >= 1: noise features this many times longer along fiberDirection than
-  // across it (1 = isotropic).
-  double anisotropy = 1.0;
-  Vec2 fiberDirection = Vec2::UnitX();  // pattern direction of the fibers
-  std::uint64_t seed = 1;
-};
 
 class FiberTexture {
  public:

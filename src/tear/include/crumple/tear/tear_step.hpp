@@ -10,23 +10,10 @@
 #include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/tear/candidates.hpp"
 #include "crumple/tear/fiber_texture.hpp"
+#include "crumple/tear/params.hpp"
 #include "crumple/tear/tip_pulls.hpp"
 
 namespace crumple::tear {
-
-struct TearParams {
-  // C: the paper's general resistance (thesis 3.3.2: 0.005), in the units
-  // of E_r, i.e. of the forces given. The pipeline gives the forces in units
-  // of the paper's stretch stiffness times the mesh's mean edge length
-  // (k_s h, the force of unit strain over one edge), so E_r is a
-  // dimensionless, strain-like number independent of the mesh resolution
-  // and C = 0.005 tears where the pull at a point reaches the force of half
-  // a percent of strain (office paper breaks at 1.5-3 %).
-  double resistance = 0.005;
-  double tipDamage = 0.5;       // D in [0, 1]: d_p at a tear's tip (1 elsewhere)
-  double speed = 1.0;           // V (m per unit of E_r): the tip advances V E_r per step
-  double minInwardAngle = 0.1;  // rad: inward corners sharper than pi + this
-};
 
 struct CandidateTest {
   TearCandidate candidate;

@@ -7,7 +7,6 @@
 // (cutAlong) and every advance is recorded with its detail path
 // (TearSegment) for the baked tear textures.
 #include <cstdint>
-#include <numbers>
 #include <string>
 #include <vector>
 
@@ -16,39 +15,11 @@
 #include "crumple/tear/cut.hpp"
 #include "crumple/tear/detail_path.hpp"
 #include "crumple/tear/fiber_texture.hpp"
+#include "crumple/tear/params.hpp"
 #include "crumple/tear/tear_segment.hpp"
 #include "crumple/tear/tear_step.hpp"
 
 namespace crumple::tear {
-
-struct TearingParams {
-  TearParams griffith;  // C, D, V, the inward-corner angle
-  FiberTextureParams
-      fibers;  // T_fibers; texelSize is the detail's resolution (seed is set by Tearing)
-  DetailPathParams detail;  // p and G_t's width
-  // The tip's advance V E_r is held between these multiples of the mesh's
-  // mean edge length: the mesh cannot show a shorter advance without sliver
-  // triangles (the detail path shows the fine shape), and a longer one per
-  // frame would cut across forces the elastic step has not seen.
-  double minAdvance = 0.5;
-  double maxAdvance = 2.0;
-  double snap = 0.2;            // CutOptions::snap
-  int maxNewTearsPerFrame = 1;  // the strongest candidates (E_r / E_f) start first
-  // eps_a (thesis 3.3.3, Fig. 3.20; rad): where a tear turns by more than
-  // this at a tip it leaves behind, that point stays a candidate (its lip's
-  // inward corner: the tear may branch there); elsewhere a tear's lips are
-  // not candidates.
-  double branchAngle = 0.1;
-  // A new tear whose direction makes less than this angle (rad) with the
-  // outline at its start does not start (0: any). The crumpling model's
-  // coarse S_G cannot mesh the thin strip such a tear leaves along the
-  // outline (its elastic step fails on the sliver triangles).
-  double minStartAngle = 0.0;
-  // A tip does not advance in a direction that turns by more than this
-  // (rad) from its tear's last advance (pi: any). The crumpling model's
-  // slit cannot turn back on itself.
-  double maxTurn = std::numbers::pi;
-};
 
 // One advance of one tear in a frame.
 struct TearEvent {
@@ -100,7 +71,7 @@ class Tearing {
   TearFrameResult replay(mesh::SheetMesh& mesh, const std::vector<TearEvent>& events,
                          const std::vector<char>& held);
 
-  // The crumpling model's sheet (issue 6, docs/TEARING.md "The crumpling
+  // The crumpling model's sheet (docs/TEARING.md "The crumpling
   // model torn"): its cuts are made in S_G (paper::cutGeometricMesh) and S_P
   // is rebuilt from S_G every animation step, with new vertex numbers. This
   // finds each tear's tip again on `mesh` (the boundary vertex at the last
@@ -124,7 +95,7 @@ class Tearing {
   const FiberTexture& fibers() const { return fibers_; }
   double edgeLength() const { return edgeLength_; }
 
-  // Checkpoint and resume (issue 8): the tears (tips, lips, start kinds,
+  // Checkpoint and resume (docs/CHECKPOINT.md): the tears (tips, lips, start kinds,
   // every advance) and the edge length the advances are measured in, for a
   // Tearing made again with the same parameters and seed on a mesh of the
   // same pattern (its fiber texture depends on those only). restoreState

@@ -1,6 +1,7 @@
 #pragma once
 // Paper as a thin elastic plate: stretch and bending stiffness from thickness,
 // Young's modulus and Poisson ratio (Kirchhoff-Love plate theory).
+// Header-only: the scene's paper preset fills it (io).
 #include <string>
 
 namespace crumple::sim {
@@ -24,6 +25,8 @@ struct Material {
     return youngsModulus * thickness * thickness * thickness /
            (12.0 * (1.0 - poissonRatio * poissonRatio));
   }
+
+  bool operator==(const Material&) const = default;
 };
 
 }  // namespace crumple::sim

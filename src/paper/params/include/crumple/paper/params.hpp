@@ -1,6 +1,7 @@
 #pragma once
 // User parameters of the hybrid crumpling model (paper Table VI; thesis
-// 2.3.3, 2.4.1). Lengths are in metres, angles in radians.
+// 2.3.3, 2.4.1), header-only: the scene's [model] table fills them (io),
+// HybridSheet runs them. Lengths are in metres, angles in radians.
 #include <numbers>
 #include <string>
 
@@ -87,6 +88,8 @@ struct CrumpleParams {
 #else
   bool checkInvariants = true;
 #endif
+
+  bool operator==(const CrumpleParams&) const = default;
 };
 
 }  // namespace crumple::paper
