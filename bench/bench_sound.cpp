@@ -1,4 +1,4 @@
-// What the soundtrack costs ("synthesis speed as a multiple of real
+// What the soundtrack costs (its requirement: "synthesis speed as a multiple of real
 // time per sample (target >= 200x) and the per-frame cost of events and
 // resonators"):
 //
@@ -53,7 +53,7 @@ int main(int argc, char** argv) {
   std::vector<Row> rows;
   for (const std::string& name : samples) {
     const io::SceneSpec scene = bench::sampleScene(name);
-    if (!scene.sound.enabled) {
+    if (!scene.soundEnabled) {
       std::fprintf(stderr, "bench_sound: %s has no [sound] table\n", name.c_str());
       return 2;
     }
