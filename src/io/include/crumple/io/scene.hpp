@@ -2,7 +2,7 @@
 // The scene file (scene.toml, parsed with toml++): what one shot is.
 // All lengths are converted to metres on parse (scene `units`), angles to
 // radians. Unknown keys and bad values throw crumple::InputError naming the
-// file, the line and the key (DESIGN.md "Invariants").
+// file, the line and the key (docs/ARCHITECTURE.md "Invariants everyone keeps").
 // The simulation's parameters are parsed straight into the modules' own
 // structs (sim::SimParams, sim::Material, paper::CrumpleParams,
 // tear::TearingParams, sound::EventParams: header-only, their defaults
