@@ -37,17 +37,11 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bench::ShotBenchArgs args = bench::parseShotBenchArgs(argc, argv);
-  if (args.help) {
-    std::printf("usage: bench_contacts [SAMPLE ...] [--runs 3] [--json FILE]\n");
-    return 0;
-  }
+  const auto parsed = bench::parseShotBenchArgs(argc, argv, "bench_contacts", {"slide-on-table", "press-on-sphere", "fold-over"});
+  if (!parsed) return 0;
+  const bench::ShotBenchArgs& args = *parsed;
   const int runs = args.runs;
-  const std::string jsonPath = args.jsonPath;
-  const std::vector<std::string> samples =
-      args.samples.empty()
-          ? std::vector<std::string>{"slide-on-table", "press-on-sphere", "fold-over"}
-          : args.samples;
+  const std::vector<std::string>& samples = args.samples;
   setThreadCount(1);
   const fs::path scratch = fs::temp_directory_path() / "crumple-bench-contacts";
   std::vector<Row> rows;
@@ -85,20 +79,14 @@ int main(int argc, char** argv) {
   }
   std::error_code ignored;
   fs::remove_all(scratch, ignored);
-  if (!jsonPath.empty()) {
-    std::vector<std::string> json;
-    for (const Row& r : rows) {
-      char text[512];
-      std::snprintf(text, sizeof text,
-                    "{\"sample\": \"%s\", \"frames\": %d, \"step_ms_per_frame\": %.6g, "
-                    "\"collider_ms_per_frame\": %.6g, \"self_contact_ms_per_frame\": %.6g, "
-                    "\"share_of_step\": %.6g, \"depth_check_ms_per_frame\": %.6g, "
-                    "\"max_depth_thicknesses\": %.6g}",
-                    r.sample.c_str(), r.frames, r.stepMs, r.colliderMs, r.selfMs, r.share,
-                    r.checkMs, r.depth);
-      json.emplace_back(text);
-    }
-    if (!bench::writeSampleRows(jsonPath, "bench_contacts", runs, json)) return 1;
-  }
+  const auto toJson = [](const Row& r) {
+    return bench::format("{\"sample\": \"%s\", \"frames\": %d, \"step_ms_per_frame\": %.6g, "
+                  "\"collider_ms_per_frame\": %.6g, \"self_contact_ms_per_frame\": %.6g, "
+                  "\"share_of_step\": %.6g, \"depth_check_ms_per_frame\": %.6g, "
+                  "\"max_depth_thicknesses\": %.6g}",
+                  r.sample.c_str(), r.frames, r.stepMs, r.colliderMs, r.selfMs, r.share,
+                  r.checkMs, r.depth);
+  };
+  if (!bench::writeSampleRows(args, "bench_contacts", rows, toJson)) return 1;
   return 0;
 }

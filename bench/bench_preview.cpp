@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "crumple/exporters/pcache.hpp"
+#include "crumple/cache/pcache.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/shot.hpp"

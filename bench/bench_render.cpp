@@ -63,9 +63,10 @@
 #include <thread>
 #include <vector>
 
+#include "crumple/cache/pcache.hpp"
 #include "crumple/core/error.hpp"
+#include "crumple/core/exit_status.hpp"
 #include "crumple/core/parallel.hpp"
-#include "crumple/exporters/pcache.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/shot.hpp"
@@ -706,13 +707,5 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(parseArgs(argc, argv));
-  } catch (const InputError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bench_render: %s\n", e.what());
-    return 1;
-  }
+  return runWithExitStatus("bench_render", [&] { return run(parseArgs(argc, argv)); });
 }

@@ -39,15 +39,10 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bench::ShotBenchArgs args = bench::parseShotBenchArgs(argc, argv);
-  if (args.help) {
-    std::printf("usage: bench_sound [SAMPLE ...] [--runs 3] [--json FILE]\n");
-    return 0;
-  }
-  const std::vector<std::string> samples =
-      args.samples.empty()
-          ? std::vector<std::string>{"wiggle", "slide-on-table", "crumple", "tear-fast"}
-          : args.samples;
+  const auto parsed = bench::parseShotBenchArgs(argc, argv, "bench_sound", {"wiggle", "slide-on-table", "crumple", "tear-fast"});
+  if (!parsed) return 0;
+  const bench::ShotBenchArgs& args = *parsed;
+  const std::vector<std::string>& samples = args.samples;
   setThreadCount(1);
   const fs::path scratch = fs::temp_directory_path() / "crumple-bench-sound";
   std::vector<Row> rows;
@@ -96,20 +91,14 @@ int main(int argc, char** argv) {
   }
   std::error_code ignored;
   fs::remove_all(scratch, ignored);
-  if (!args.jsonPath.empty()) {
-    std::vector<std::string> json;
-    for (const Row& r : rows) {
-      char text[512];
-      std::snprintf(text, sizeof text,
-                    "{\"sample\": \"%s\", \"frames\": %d, \"events\": %ld, "
-                    "\"step_ms_per_frame\": %.6g, \"events_ms_per_frame\": %.6g, "
-                    "\"resonator_ms_per_frame\": %.6g, \"seconds\": %.6g, \"synthesis_ms\": %.6g, "
-                    "\"x_real_time\": %.6g}",
-                    r.sample.c_str(), r.frames, r.events, r.stepMs, r.eventsMs, r.resonatorMs,
-                    r.seconds, r.synthesisMs, r.realTime);
-      json.emplace_back(text);
-    }
-    if (!bench::writeSampleRows(args.jsonPath, "bench_sound", args.runs, json)) return 1;
-  }
+  const auto toJson = [](const Row& r) {
+    return bench::format("{\"sample\": \"%s\", \"frames\": %d, \"events\": %ld, "
+                  "\"step_ms_per_frame\": %.6g, \"events_ms_per_frame\": %.6g, "
+                  "\"resonator_ms_per_frame\": %.6g, \"seconds\": %.6g, \"synthesis_ms\": %.6g, "
+                  "\"x_real_time\": %.6g}",
+                  r.sample.c_str(), r.frames, r.events, r.stepMs, r.eventsMs, r.resonatorMs,
+                  r.seconds, r.synthesisMs, r.realTime);
+  };
+  if (!bench::writeSampleRows(args, "bench_sound", rows, toJson)) return 1;
   return 0;
 }

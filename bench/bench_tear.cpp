@@ -36,16 +36,11 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bench::ShotBenchArgs args = bench::parseShotBenchArgs(argc, argv);
-  if (args.help) {
-    std::printf("usage: bench_tear [SAMPLE ...] [--runs 3] [--json FILE]\n");
-    return 0;
-  }
+  const auto parsed = bench::parseShotBenchArgs(argc, argv, "bench_tear", {"tear-straight", "tear-curved", "tear-notch"});
+  if (!parsed) return 0;
+  const bench::ShotBenchArgs& args = *parsed;
   const int runs = args.runs;
-  const std::string jsonPath = args.jsonPath;
-  const std::vector<std::string> samples =
-      args.samples.empty() ? std::vector<std::string>{"tear-straight", "tear-curved", "tear-notch"}
-                           : args.samples;
+  const std::vector<std::string>& samples = args.samples;
   setThreadCount(1);
   const fs::path scratch = fs::temp_directory_path() / "crumple-bench-tear";
   std::vector<Row> rows;
@@ -79,18 +74,12 @@ int main(int argc, char** argv) {
   }
   std::error_code ignored;
   fs::remove_all(scratch, ignored);
-  if (!jsonPath.empty()) {
-    std::vector<std::string> json;
-    for (const Row& r : rows) {
-      char text[512];
-      std::snprintf(text, sizeof text,
-                    "{\"sample\": \"%s\", \"frames\": %d, \"tip_advances\": %zu, "
-                    "\"step_ms_per_frame\": %.6g, \"tear_ms_per_frame\": %.6g, "
-                    "\"bake_ms_per_frame\": %.6g, \"share_of_step\": %.6g}",
-                    r.sample.c_str(), r.frames, r.advances, r.stepMs, r.tearMs, r.bakeMs, r.share);
-      json.emplace_back(text);
-    }
-    if (!bench::writeSampleRows(jsonPath, "bench_tear", runs, json)) return 1;
-  }
+  const auto toJson = [](const Row& r) {
+    return bench::format("{\"sample\": \"%s\", \"frames\": %d, \"tip_advances\": %zu, "
+                  "\"step_ms_per_frame\": %.6g, \"tear_ms_per_frame\": %.6g, "
+                  "\"bake_ms_per_frame\": %.6g, \"share_of_step\": %.6g}",
+                  r.sample.c_str(), r.frames, r.advances, r.stepMs, r.tearMs, r.bakeMs, r.share);
+  };
+  if (!bench::writeSampleRows(args, "bench_tear", rows, toJson)) return 1;
   return 0;
 }

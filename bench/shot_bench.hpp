@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,11 +16,13 @@ namespace crumple::bench {
 struct ShotBenchArgs {
   int runs = 3;
   std::string jsonPath;
-  std::vector<std::string> samples;  // empty: the benchmark's defaults
-  bool help = false;
+  std::vector<std::string> samples;
 };
 
-inline ShotBenchArgs parseShotBenchArgs(int argc, char** argv) {
+// The command line of benchmark `bench`, its samples `defaults` unless some
+// are named; nullopt after printing the usage for --help.
+inline std::optional<ShotBenchArgs> parseShotBenchArgs(int argc, char** argv, const char* bench,
+                                                       std::vector<std::string> defaults) {
   ShotBenchArgs args;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -28,12 +31,22 @@ inline ShotBenchArgs parseShotBenchArgs(int argc, char** argv) {
     } else if (a == "--json" && i + 1 < argc) {
       args.jsonPath = argv[++i];
     } else if (a == "--help" || a == "-h") {
-      args.help = true;
+      std::printf("usage: %s [SAMPLE ...] [--runs 3] [--json FILE]\n", bench);
+      return std::nullopt;
     } else {
       args.samples.push_back(a);
     }
   }
+  if (args.samples.empty()) args.samples = std::move(defaults);
   return args;
+}
+
+// printf into a string (a JSON row).
+template <typename... Values>
+std::string format(const char* pattern, Values... values) {
+  char text[512];
+  std::snprintf(text, sizeof text, pattern, values...);
+  return text;
 }
 
 inline double median(std::vector<double> v) {
@@ -68,18 +81,21 @@ inline double stepTotalMs(const pipeline::ShotReport& report) {
   return total;
 }
 
-// Writes {"runs": N, "samples": [ROW, ...]} to `path` (each row a JSON
-// object's text). False, with a message naming `bench`, when it cannot.
-inline bool writeSampleRows(const std::string& path, const char* bench, int runs,
-                            const std::vector<std::string>& rows) {
-  std::FILE* f = std::fopen(path.c_str(), "w");
+// Writes {"runs": N, "samples": [ROW, ...]} to the --json path, each row the
+// JSON object `toJson` makes of it; nothing without --json. False, with a
+// message naming `bench`, when it cannot.
+template <typename Row, typename ToJson>
+bool writeSampleRows(const ShotBenchArgs& args, const char* bench, const std::vector<Row>& rows,
+                     ToJson toJson) {
+  if (args.jsonPath.empty()) return true;
+  std::FILE* f = std::fopen(args.jsonPath.c_str(), "w");
   if (f == nullptr) {
-    std::fprintf(stderr, "%s: cannot write %s\n", bench, path.c_str());
+    std::fprintf(stderr, "%s: cannot write %s\n", bench, args.jsonPath.c_str());
     return false;
   }
-  std::fprintf(f, "{\"runs\": %d, \"samples\": [", runs);
+  std::fprintf(f, "{\"runs\": %d, \"samples\": [", args.runs);
   for (std::size_t i = 0; i < rows.size(); ++i)
-    std::fprintf(f, "%s%s", i == 0 ? "" : ", ", rows[i].c_str());
+    std::fprintf(f, "%s%s", i == 0 ? "" : ", ", toJson(rows[i]).c_str());
   std::fprintf(f, "]}\n");
   return std::fclose(f) == 0;
 }

@@ -42,15 +42,13 @@ all_scenes() {
 # so both binaries must read it from the same place) with the cost guard off
 # ([scene] frame_budget_s = 0): the guard stops a run by wall-clock time, which
 # a loaded machine changes; it never changes what a finished run writes.
+# Every sample folder is staged, whichever scenes run: a scene may read
+# another's files (backlit-cutout animates drape's glTF).
 stage_scenes() {
   local stage="$1"
-  shift
   rm -rf "$stage"
   mkdir -p "$stage"
-  for s in "$@"; do
-    local folder="${s%%/*}"
-    [ -d "$stage/$folder" ] || cp -r "$root/samples/$folder" "$stage/$folder"
-  done
+  cp -r "$root/samples/." "$stage/"
   find "$stage" -name '*.toml' -print0 | while IFS= read -r -d '' f; do
     grep -q 'frame_budget_s' "$f" || sed -i '/^\[scene\]/a frame_budget_s = 0' "$f"
   done
@@ -66,7 +64,7 @@ record() {
   local scenes=("$@")
   [ ${#scenes[@]} -gt 0 ] || mapfile -t scenes < <(all_scenes)
   local stage="${CRUMPLE_IDENTICAL_STAGE:-/tmp/crumple-identical-scenes}"
-  stage_scenes "$stage" "${scenes[@]}"
+  stage_scenes "$stage"
   local work
   work="$(mktemp -d)"
   : >"$manifest"

@@ -9,6 +9,7 @@
 
 #include "bench_harness.hpp"
 #include "crumple/core/error.hpp"
+#include "crumple/core/exit_status.hpp"
 
 int main(int argc, char** argv) {
   using namespace crumple;
@@ -52,7 +53,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return e.get_exit_code() == 0 ? app.exit(e) : (app.exit(e), 2);
   }
-  try {
+  return runWithExitStatus("crumple bench", [&] {
     std::string name;
     for (std::istringstream in(samples); std::getline(in, name, ',');)
       if (!name.empty()) options.samples.push_back(name);
@@ -63,11 +64,5 @@ int main(int argc, char** argv) {
     std::printf("report: %s/report.md\n  csv:   %s/bench.csv\n  plot:  %s/pareto.png\n",
                 options.outDir.c_str(), options.outDir.c_str(), options.outDir.c_str());
     return 0;
-  } catch (const InputError& e) {
-    std::fprintf(stderr, "crumple bench: error: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "crumple bench: error: %s\n", e.what());
-    return 1;
-  }
+  });
 }

@@ -7,10 +7,10 @@
 #include <system_error>
 
 #include "cli.hpp"
+#include "crumple/cache/pcache.hpp"
 #include "crumple/core/debug.hpp"
 #include "crumple/core/error.hpp"
 #include "crumple/core/parallel.hpp"
-#include "crumple/exporters/pcache.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/export.hpp"
 #include "crumple/pipeline/inspect.hpp"

@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "crumple/cache/pcache.hpp"
 #include "crumple/core/error.hpp"
 #include "crumple/exporters/exr.hpp"
-#include "crumple/exporters/pcache.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/pipeline/shape_compare.hpp"
 #include "crumple/render/embree_renderer.hpp"

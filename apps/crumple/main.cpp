@@ -15,6 +15,7 @@
 
 #include "cli.hpp"
 #include "crumple/core/error.hpp"
+#include "crumple/core/exit_status.hpp"
 
 namespace crumple::cli {
 namespace {
@@ -246,7 +247,7 @@ int runBench(int argc, char** argv) {
 
 // The given command, run; exceptions become the exit status.
 int dispatch(const Commands& c, const Args& a) {
-  try {
+  return runWithExitStatus("crumple", [&] {
     if (*c.run) return runOrSimulate(a, true);
     if (*c.simulate) return runOrSimulate(a, false);
     if (*c.render) return renderCommand(a);
@@ -255,20 +256,8 @@ int dispatch(const Commands& c, const Args& a) {
     if (*c.compare) return compareCommand(a);
     if (*c.exportCmd) return exportCommand(a);
     if (*c.farm) return farmCommand(a, *c.farmSlurm);
-  } catch (const InputError& e) {
-    std::fprintf(stderr, "crumple: error: %s\n", e.what());
-    return 2;
-  } catch (const NumericalError& e) {
-    std::fprintf(stderr, "crumple: numerical failure: %s\n", e.what());
     return 1;
-  } catch (const CorruptDataError& e) {
-    std::fprintf(stderr, "crumple: error: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "crumple: internal error: %s\n", e.what());
-    return 1;
-  }
-  return 1;
+  });
 }
 
 }  // namespace

@@ -15,9 +15,9 @@
 
 #include "../json_number.hpp"
 #include "../shot_bench.hpp"
+#include "crumple/cache/pcache.hpp"
 #include "crumple/core/error.hpp"
 #include "crumple/core/parallel.hpp"
-#include "crumple/exporters/pcache.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/shot.hpp"

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "crumple/core/error.hpp"
+#include "image_checks.hpp"
 
 namespace crumple::exporters {
 namespace {
@@ -92,11 +93,7 @@ std::vector<char> encode(const std::string& path, const ImageRGBAF& image) {
 
 // Atomic EXR write: encode in memory, write PATH.tmp, rename.
 void writeExr(const std::string& path, const ImageRGBAF& image) {
-  if (image.width <= 0 || image.height <= 0 ||
-      image.pixels.size() != static_cast<std::size_t>(image.width) * image.height * 4)
-    throw std::invalid_argument(path + ": cannot write EXR: invalid image (" +
-                                std::to_string(image.width) + "x" + std::to_string(image.height) +
-                                ", " + std::to_string(image.pixels.size()) + " floats)");
+  checkImageToWrite(path, "EXR", image, "floats");
   std::vector<char> bytes;
   try {
     bytes = encode(path, image);

@@ -16,8 +16,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "crumple/cache/pcache_tear.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache_tear.hpp"
 
 namespace crumple::exporters {
 namespace {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "crumple/core/error.hpp"
+#include "image_checks.hpp"
 
 namespace crumple::exporters {
 namespace {
@@ -50,6 +51,29 @@ std::string describe(const ErrorState& state) {
   return state.message[0] ? state.message : "libpng failed";
 }
 
+// libpng's write or read structs, made with the error callbacks above and
+// destroyed with the matching call.
+template <bool kWrite>
+struct PngStructs {
+  png_structp png = nullptr;
+  png_infop info = nullptr;
+  PngStructs(const PngStructs&) = delete;
+  PngStructs& operator=(const PngStructs&) = delete;
+  explicit PngStructs(ErrorState* state) {
+    png = kWrite ? png_create_write_struct(PNG_LIBPNG_VER_STRING, state, onError, onWarning)
+                 : png_create_read_struct(PNG_LIBPNG_VER_STRING, state, onError, onWarning);
+    if (png) info = png_create_info_struct(png);
+  }
+  ~PngStructs() {
+    if constexpr (kWrite)
+      png_destroy_write_struct(&png, &info);
+    else
+      png_destroy_read_struct(&png, &info, nullptr);
+  }
+};
+using WriteStructs = PngStructs<true>;
+using ReadStructs = PngStructs<false>;
+
 // --- Writing ---------------------------------------------------------------
 
 bool encode(png_structp png, png_infop info, std::FILE* file, png_bytepp rows, png_uint_32 width,
@@ -67,18 +91,6 @@ bool encode(png_structp png, png_infop info, std::FILE* file, png_bytepp rows, p
   png_write_end(png, info);
   return true;
 }
-
-struct WriteStructs {
-  png_structp png = nullptr;
-  png_infop info = nullptr;
-  WriteStructs(const WriteStructs&) = delete;
-  WriteStructs& operator=(const WriteStructs&) = delete;
-  explicit WriteStructs(ErrorState* state) {
-    png = png_create_write_struct(PNG_LIBPNG_VER_STRING, state, onError, onWarning);
-    if (png) info = png_create_info_struct(png);
-  }
-  ~WriteStructs() { png_destroy_write_struct(&png, &info); }
-};
 
 // --- Reading ---------------------------------------------------------------
 
@@ -115,26 +127,10 @@ bool decodeRows(png_structp png, png_bytepp rows) {
   return true;
 }
 
-struct ReadStructs {
-  png_structp png = nullptr;
-  png_infop info = nullptr;
-  ReadStructs(const ReadStructs&) = delete;
-  ReadStructs& operator=(const ReadStructs&) = delete;
-  explicit ReadStructs(ErrorState* state) {
-    png = png_create_read_struct(PNG_LIBPNG_VER_STRING, state, onError, onWarning);
-    if (png) info = png_create_info_struct(png);
-  }
-  ~ReadStructs() { png_destroy_read_struct(&png, &info, nullptr); }
-};
-
 }  // namespace
 
 void writePng(const std::string& path, const ImageRGBA8& image) {
-  if (image.width <= 0 || image.height <= 0 ||
-      image.pixels.size() != static_cast<std::size_t>(image.width) * image.height * 4)
-    throw std::invalid_argument(path + ": cannot write PNG: invalid image (" +
-                                std::to_string(image.width) + "x" + std::to_string(image.height) +
-                                ", " + std::to_string(image.pixels.size()) + " bytes)");
+  checkImageToWrite(path, "PNG", image, "bytes");
   const std::string tmp = path + ".tmp";
   std::vector<png_bytep> rows(static_cast<std::size_t>(image.height));
   for (int y = 0; y < image.height; ++y) rows[y] = const_cast<png_bytep>(image.at(0, y));

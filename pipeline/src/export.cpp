@@ -7,11 +7,11 @@
 #include <fstream>
 #include <memory>
 
+#include "crumple/cache/pcache.hpp"
 #include "crumple/core/error.hpp"
 #include "crumple/core/progress.hpp"
 #include "crumple/exporters/gltf_export.hpp"
 #include "crumple/exporters/mesh_export.hpp"
-#include "crumple/exporters/pcache.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/inspect.hpp"

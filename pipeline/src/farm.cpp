@@ -15,8 +15,8 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "crumple/cache/pcache.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache.hpp"
 #include "frame_output.hpp"
 
 extern char** environ;

@@ -4,9 +4,9 @@
 // and its rendering.
 #include <algorithm>
 
+#include "crumple/cache/pcache_contacts.hpp"
+#include "crumple/cache/pcache_sound.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache_contacts.hpp"
-#include "crumple/exporters/pcache_sound.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/sound.hpp"
 #include "crumple/render/view.hpp"
@@ -161,12 +161,8 @@ void ShotRunner::recordSoundEvents(int frame, const std::vector<cache::ContactRe
     throw NumericalError("sound events", frame, e.what());
   }
   if (events.empty()) return;
-  std::vector<cache::SoundEventRecord> records;
-  for (const auto& e : events) {
-    records.push_back(soundEventRecord(e));
-    ++report_.soundEvents[static_cast<std::size_t>(e.kind)];
-  }
-  record_.extensions.push_back(cache::encodeSoundEvents(records));
+  for (const auto& e : events) ++report_.soundEvents[static_cast<std::size_t>(e.kind)];
+  record_.extensions.push_back(cache::encodeSoundEvents(events));
 }
 
 }  // namespace crumple::pipeline

@@ -1,78 +1,19 @@
 // What the renderers draw for a cached frame (shot.hpp: FrameViewBuilder),
 // and the look data a cache carries so that rendering needs nothing else
 // (docs/PCACHE.md "Extension sub-blocks written by crumple").
-#include <bit>
 #include <cmath>
-#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <limits>
 
+#include "crumple/cache/pcache_look.hpp"
+#include "crumple/cache/pcache_tear.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache_tear.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/shot.hpp"
 
 namespace crumple::pipeline {
-
-namespace {
-
-static_assert(std::endian::native == std::endian::little,
-              "the cache's extension blocks are written in host order, little-endian");
-
-constexpr std::array<char, 4> kTextureTag = {'P', 'T', 'E', 'X'};
-constexpr std::array<char, 4> kPropMeshTag = {'P', 'R', 'O', 'P'};
-constexpr std::array<char, 4> kPropMotionTag = {'P', 'R', 'P', 'M'};
-
-// Little-endian append / read of plain values.
-class BlockWriter {
- public:
-  template <typename T>
-  void put(const T& v) {
-    const auto* p = reinterpret_cast<const std::uint8_t*>(&v);
-    bytes.insert(bytes.end(), p, p + sizeof(T));
-  }
-  std::vector<std::uint8_t> bytes;
-};
-
-class BlockReader {
- public:
-  BlockReader(const std::vector<std::uint8_t>& bytes, std::string what)
-      : bytes_(bytes), what_(std::move(what)) {}
-  template <typename T>
-  T get() {
-    if (bytes_.size() - pos_ < sizeof(T)) throw CorruptDataError(what_ + ": truncated");
-    T v;
-    std::memcpy(&v, bytes_.data() + pos_, sizeof(T));
-    pos_ += sizeof(T);
-    return v;
-  }
-  // A count of items of `itemBytes` each that must fit in what is left.
-  std::uint32_t count(std::size_t itemBytes) {
-    const auto n = get<std::uint32_t>();
-    if (static_cast<std::uint64_t>(n) * itemBytes > bytes_.size() - pos_)
-      throw CorruptDataError(what_ + ": count " + std::to_string(n) + " exceeds the block");
-    return n;
-  }
-  void expectEnd() const {
-    if (pos_ != bytes_.size()) throw CorruptDataError(what_ + ": trailing bytes");
-  }
-
- private:
-  const std::vector<std::uint8_t>& bytes_;
-  std::string what_;
-  std::size_t pos_ = 0;
-};
-
-const cache::ExtensionBlock* findBlock(const std::vector<cache::ExtensionBlock>& blocks,
-                                       const std::array<char, 4>& tag) {
-  for (const auto& b : blocks)
-    if (b.tag == tag) return &b;
-  return nullptr;
-}
-
-}  // namespace
 
 mesh::SheetMesh sheetOfFrame(const cache::FrameRecord& frame) {
   mesh::SheetMesh m;
@@ -164,100 +105,70 @@ std::vector<cache::ExtensionBlock> lookHeaderBlocks(const io::SceneSpec& scene,
     if (!in)
       throw InputError(scene.file, scene.look.textureLine, "paper.texture",
                        "cannot read " + scene.look.texture);
-    cache::ExtensionBlock b;
-    b.tag = kTextureTag;
-    b.data.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    std::vector<std::uint8_t> png(std::istreambuf_iterator<char>(in),
+                                  (std::istreambuf_iterator<char>()));
     // Checked now, so that a bad file is an input error before anything is written.
     try {
-      (void)exporters::decodePngBytes(b.data, scene.look.texture);
+      (void)exporters::decodePngBytes(png, scene.look.texture);
     } catch (const InputError& e) {
       throw InputError(scene.file, scene.look.textureLine, "paper.texture", e.what());
     }
-    blocks.push_back(std::move(b));
+    blocks.push_back(cache::encodePaperTexture(std::move(png)));
   }
-  BlockWriter w;
-  std::uint32_t meshProps = 0;
-  for (const auto& p : scene.props) meshProps += p.node.empty() ? 0 : 1;
-  if (meshProps > 0) {
+  std::vector<cache::PropMeshRecord> meshes;
+  for (const auto& p : scene.props) {
+    if (p.node.empty()) continue;
     if (animation == nullptr)
       throw InputError(scene.file, "[[props]] mesh nodes need the animation file");
-    w.put(meshProps);
-    for (const auto& p : scene.props) {
-      if (p.node.empty()) continue;
-      const auto m = animation->mesh(p.node);
-      if (!m || m->triangles.empty())
-        throw InputError(scene.file, p.nodeLine, "props.node",
-                         "node '" + p.node + "' holds no triangle mesh");
-      w.put(static_cast<std::uint32_t>(m->vertices.size()));
-      for (const Vec3& v : m->vertices)
-        for (int k = 0; k < 3; ++k) w.put(v[k]);
-      w.put(static_cast<std::uint32_t>(m->triangles.size()));
-      for (const auto& t : m->triangles)
-        for (const int i : t) w.put(static_cast<std::int32_t>(i));
-    }
-    blocks.push_back({kPropMeshTag, std::move(w.bytes)});
+    const auto m = animation->mesh(p.node);
+    if (!m || m->triangles.empty())
+      throw InputError(scene.file, p.nodeLine, "props.node",
+                       "node '" + p.node + "' holds no triangle mesh");
+    meshes.push_back({m->vertices, m->triangles});
   }
+  if (!meshes.empty()) blocks.push_back(cache::encodePropMeshes(meshes));
   return blocks;
 }
 
 std::optional<cache::ExtensionBlock> propMotionBlock(const io::SceneSpec& scene,
                                                      const io::AnimationScene* animation,
                                                      double t) {
-  BlockWriter w;
-  std::uint32_t n = 0;
-  for (const auto& p : scene.props) n += p.node.empty() ? 0 : 1;
-  if (n == 0 || animation == nullptr) return std::nullopt;
-  w.put(n);
+  if (animation == nullptr) return std::nullopt;
+  std::vector<Mat4> motions;
   for (const auto& p : scene.props) {
     if (p.node.empty()) continue;
     // The stored mesh is the node's world mesh at t = 0: carry it along.
-    const Mat4 motion =
-        animation->worldMatrix(p.node, t) * animation->worldMatrix(p.node, 0.0).inverse();
-    for (int c = 0; c < 4; ++c)
-      for (int r = 0; r < 4; ++r) w.put(motion(r, c));
+    motions.push_back(animation->worldMatrix(p.node, t) *
+                      animation->worldMatrix(p.node, 0.0).inverse());
   }
-  return cache::ExtensionBlock{kPropMotionTag, std::move(w.bytes)};
+  if (motions.empty()) return std::nullopt;
+  return cache::encodePropMotions(motions);
 }
 
 FrameViewBuilder::FrameViewBuilder(const io::SceneSpec& scene,
                                    const std::vector<cache::ExtensionBlock>& headerBlocks)
     : scene_(scene) {
-  if (const auto* tex = findBlock(headerBlocks, kTextureTag))
-    texture_ = exporters::decodePngBytes(tex->data, "the cache's paper texture");
+  if (const auto* png = cache::findPaperTexture(headerBlocks))
+    texture_ = exporters::decodePngBytes(*png, "the cache's paper texture");
   else
     texture_ = render::makeRuledPaperTexture(512, 512);
   for (const auto& p : scene.props)
     if (p.node.empty()) boxes_.push_back(boxProp(p));
-  if (const auto* props = findBlock(headerBlocks, kPropMeshTag)) {
-    BlockReader r(props->data, "the cache's prop meshes");
-    const std::uint32_t n = r.count(8);
+  if (auto meshes = cache::decodePropMeshes(headerBlocks)) {
     std::vector<const io::PropSpec*> specs;
     for (const auto& p : scene.props)
       if (!p.node.empty()) specs.push_back(&p);
-    if (n != specs.size())
-      throw CorruptDataError("the cache holds " + std::to_string(n) + " prop meshes, its scene " +
-                             std::to_string(specs.size()));
-    for (std::uint32_t i = 0; i < n; ++i) {
+    if (meshes->size() != specs.size())
+      throw CorruptDataError("the cache holds " + std::to_string(meshes->size()) +
+                             " prop meshes, its scene " + std::to_string(specs.size()));
+    for (std::size_t i = 0; i < specs.size(); ++i) {
       render::PropMesh m;
       m.name = specs[i]->name;
       m.color = specs[i]->color;
-      m.vertices.resize(r.count(24));
-      for (Vec3& v : m.vertices) {
-        for (int k = 0; k < 3; ++k) v[k] = r.get<double>();
-        if (!v.allFinite())
-          throw CorruptDataError("the cache's prop meshes: a vertex of '" + m.name +
-                                 "' is not finite");
-      }
-      m.triangles.resize(r.count(12));
-      for (auto& t : m.triangles)
-        for (int& k : t) {
-          k = r.get<std::int32_t>();
-          if (k < 0 || static_cast<std::size_t>(k) >= m.vertices.size())
-            throw CorruptDataError("the cache's prop meshes: vertex index out of range");
-        }
+      m.vertices = std::move((*meshes)[i].vertices);
+      m.triangles = std::move((*meshes)[i].triangles);
       meshPropsAtRest_.push_back(std::move(m));
     }
-    r.expectEnd();
   }
 }
 
@@ -278,26 +189,18 @@ FrameView FrameViewBuilder::build(const cache::FrameRecord& frame) const {
   }
   fv.scene.props = boxes_;
   if (!meshPropsAtRest_.empty()) {
-    const auto* motions = findBlock(frame.extensions, kPropMotionTag);
-    if (motions == nullptr)
+    const auto motions = cache::decodePropMotions(frame.extensions);
+    if (!motions)
       throw CorruptDataError("frame " + std::to_string(frame.frame) +
                              " of the cache lacks its prop motions");
-    BlockReader r(motions->data, "frame " + std::to_string(frame.frame) + " prop motions");
-    if (r.count(128) != meshPropsAtRest_.size())
+    if (motions->size() != meshPropsAtRest_.size())
       throw CorruptDataError("frame " + std::to_string(frame.frame) +
                              ": prop motions do not match the prop meshes");
-    for (const auto& rest : meshPropsAtRest_) {
-      Mat4 motion;
-      for (int c = 0; c < 4; ++c)
-        for (int row = 0; row < 4; ++row) motion(row, c) = r.get<double>();
-      if (!motion.allFinite())
-        throw CorruptDataError("frame " + std::to_string(frame.frame) + ": the motion of prop '" +
-                               rest.name + "' is not finite");
-      render::PropMesh m = rest;
-      for (Vec3& v : m.vertices) v = (motion * v.homogeneous()).head<3>();
+    for (std::size_t i = 0; i < motions->size(); ++i) {
+      render::PropMesh m = meshPropsAtRest_[i];
+      for (Vec3& v : m.vertices) v = ((*motions)[i] * v.homogeneous()).head<3>();
       fv.scene.props.push_back(std::move(m));
     }
-    r.expectEnd();
   }
   fv.scene.sharpVertices = frame.singularVertices;
   fv.sheet = sheetOfFrame(frame);

@@ -9,8 +9,8 @@
 #include <optional>
 #include <utility>
 
+#include "crumple/cache/pcache_contacts.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache_contacts.hpp"
 #include "crumple/sim/self_contact.hpp"
 #include "json_writer.hpp"
 
@@ -299,14 +299,8 @@ std::string inspectJson(const cache::CacheReader& reader) {
     if (m.structure) {
       const cache::StructureChanges& s = *m.structure;
       j.key("structure_changes").beginObject();
-      j.key("singular_from_flat").value(static_cast<long long>(s.singularFromFlat));
-      j.key("singular_from_ruling").value(static_cast<long long>(s.singularFromRuling));
-      j.key("curved_from_compression").value(static_cast<long long>(s.curvedFromCompression));
-      j.key("curved_from_folding").value(static_cast<long long>(s.curvedFromFolding));
-      j.key("creases").value(static_cast<long long>(s.creases));
-      j.key("flat_splits").value(static_cast<long long>(s.flatSplits));
-      j.key("curved_flattened").value(static_cast<long long>(s.curvedFlattened));
-      j.key("undone_by_stretch").value(static_cast<long long>(s.undoneByStretch));
+      for (const cache::StructureField& field : cache::kStructureFieldList)
+        j.key(field.name).value(static_cast<long long>(s.*field.count));
       j.endObject();
     }
     if (header.paperThickness > 0.0) {

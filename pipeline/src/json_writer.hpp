@@ -10,28 +10,10 @@ namespace crumple::pipeline {
 
 class JsonWriter {
  public:
-  JsonWriter& beginObject() {
-    separate();
-    out_ += '{';
-    first_ = true;
-    return *this;
-  }
-  JsonWriter& endObject() {
-    out_ += '}';
-    first_ = false;
-    return *this;
-  }
-  JsonWriter& beginArray() {
-    separate();
-    out_ += '[';
-    first_ = true;
-    return *this;
-  }
-  JsonWriter& endArray() {
-    out_ += ']';
-    first_ = false;
-    return *this;
-  }
+  JsonWriter& beginObject() { return open('{'); }
+  JsonWriter& endObject() { return close('}'); }
+  JsonWriter& beginArray() { return open('['); }
+  JsonWriter& endArray() { return close(']'); }
   JsonWriter& key(std::string_view k) {
     separate();
     quote(k);
@@ -75,6 +57,17 @@ class JsonWriter {
   const std::string& str() const { return out_; }
 
  private:
+  JsonWriter& open(char bracket) {
+    separate();
+    out_ += bracket;
+    first_ = true;
+    return *this;
+  }
+  JsonWriter& close(char bracket) {
+    out_ += bracket;
+    first_ = false;
+    return *this;
+  }
   void separate() {
     if (!first_) out_ += ',';
     first_ = false;

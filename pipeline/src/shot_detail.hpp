@@ -3,7 +3,7 @@
 #include <string>
 #include <vector>
 
-#include "crumple/exporters/pcache.hpp"
+#include "crumple/cache/pcache.hpp"
 #include "crumple/io/animation.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/shot.hpp"

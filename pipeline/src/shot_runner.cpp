@@ -4,12 +4,12 @@
 #include <cstdio>
 #include <utility>
 
+#include "crumple/cache/pcache_contacts.hpp"
+#include "crumple/cache/pcache_sound.hpp"
+#include "crumple/cache/pcache_structure.hpp"
+#include "crumple/cache/pcache_tear.hpp"
 #include "crumple/core/error.hpp"
 #include "crumple/core/work_budget.hpp"
-#include "crumple/exporters/pcache_contacts.hpp"
-#include "crumple/exporters/pcache_sound.hpp"
-#include "crumple/exporters/pcache_structure.hpp"
-#include "crumple/exporters/pcache_tear.hpp"
 #include "shot_detail.hpp"
 
 namespace crumple::pipeline {
@@ -48,19 +48,6 @@ void noteSpan(int happened, int frame, ShotReport::FrameSpan& span) {
   if (happened <= 0) return;
   if (span.first < 0) span.first = frame;
   span.last = frame;
-}
-
-cache::StructureChanges cacheStructureChanges(const model::StructureChanges& s) {
-  cache::StructureChanges c;
-  c.singularFromFlat = s.singularFromFlat;
-  c.singularFromRuling = s.singularFromRuling;
-  c.curvedFromCompression = s.curvedFromCompression;
-  c.curvedFromFolding = s.curvedFromFolding;
-  c.creases = s.creases;
-  c.flatSplits = s.flatSplits;
-  c.curvedFlattened = s.curvedFlattened;
-  c.undoneByStretch = s.undoneByStretch;
-  return c;
 }
 
 }  // namespace
@@ -234,8 +221,7 @@ void ShotRunner::step(int frame) {
     r.stages[name].frames += 1;
   }
   structureBlock_.reset();
-  if (s.structure)
-    structureBlock_ = cache::encodeStructureChanges(cacheStructureChanges(*s.structure));
+  if (s.structure) structureBlock_ = cache::encodeStructureChanges(*s.structure);
 }
 
 // The tearing stage (model::TearStage), and the tear textures in the cache.

@@ -12,8 +12,8 @@
 
 #include "checkpoint.hpp"
 #include "cost_guard.hpp"
+#include "crumple/cache/pcache.hpp"
 #include "crumple/core/progress.hpp"
-#include "crumple/exporters/pcache.hpp"
 #include "crumple/io/animation.hpp"
 #include "crumple/model/sheet_setup.hpp"
 #include "crumple/model/tear_stage.hpp"

@@ -9,9 +9,9 @@
 #include <optional>
 #include <sstream>
 
+#include "crumple/cache/pcache.hpp"
 #include "crumple/core/error.hpp"
 #include "crumple/core/progress.hpp"
-#include "crumple/exporters/pcache.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/output_lock.hpp"
@@ -27,22 +27,10 @@ namespace {
 
 constexpr double kPeakDbfs = -1.0;  // the normalised mix's peak
 
-cache::ResonatorRecord resonatorRecord(const sound::Resonator& r) {
-  return {r.ruling, r.border, r.area, r.centre, r.normal, r.radius};
-}
-sound::Resonator resonatorOf(const cache::ResonatorRecord& r) {
-  sound::Resonator q;
-  q.ruling = r.ruling;
-  q.border = r.border;
-  q.area = r.area;
-  q.centre = r.centre;
-  q.normal = r.normal;
-  q.radius = r.radius;
-  return q;
-}
-
-const char* kindName(std::uint8_t kind) {
-  return kind == 0 ? "crumpling" : kind == 1 ? "friction" : "tearing";
+const char* kindName(sound::EventKind kind) {
+  return kind == sound::EventKind::Crumpling ? "crumpling"
+         : kind == sound::EventKind::Friction ? "friction"
+                                              : "tearing";
 }
 
 // The table the sources are mirrored in (4.3.4): the scene's first plane
@@ -64,30 +52,6 @@ void renameInto(const fs::path& tmp, const fs::path& path) {
 }
 
 }  // namespace
-
-sound::SoundEvent soundEventOf(const cache::SoundEventRecord& r) {
-  sound::SoundEvent e;
-  e.kind = static_cast<sound::EventKind>(r.kind);
-  e.tear = r.tear;
-  e.amplitude = r.amplitude;
-  e.duration = r.duration;
-  e.position = r.position;
-  e.normal = r.normal;
-  for (const auto& q : r.resonators) e.resonators.push_back(resonatorOf(q));
-  return e;
-}
-
-cache::SoundEventRecord soundEventRecord(const sound::SoundEvent& e) {
-  cache::SoundEventRecord r;
-  r.kind = static_cast<std::uint8_t>(e.kind);
-  r.tear = e.tear;
-  r.amplitude = e.amplitude;
-  r.duration = e.duration;
-  r.position = e.position;
-  r.normal = e.normal;
-  for (const auto& q : e.resonators) r.resonators.push_back(resonatorRecord(q));
-  return r;
-}
 
 std::string defaultSoundDatabase() {
   if (const char* env = std::getenv("CRUMPLE_ASSETS"); env && *env) {
@@ -112,7 +76,7 @@ std::string soundPath(const std::string& cachePath, const std::string& out) {
 }
 
 // A frame's SEVT block, its errors naming the cache and the frame.
-std::optional<std::vector<cache::SoundEventRecord>> frameEvents(const std::string& cachePath,
+std::optional<std::vector<sound::SoundEvent>> frameEvents(const std::string& cachePath,
                                                                 const cache::FrameRecord& record) {
   try {
     return cache::decodeSoundEvents(record.extensions);
@@ -171,14 +135,14 @@ SoundReport makeSound(const std::string& cachePath, const SoundOptions& options)
     f.right = record.camera.rotation * Vec3::UnitX();
     if (const auto events = frameEvents(cachePath, record))
       for (const auto& r : *events) {
-        f.events.push_back(soundEventOf(r));
+        f.events.push_back(r);
         switch (r.kind) {
-          case 0:
+          case sound::EventKind::Crumpling:
             ++report.crumplingEvents;
             for (const auto& q : r.resonators)
               ++(q.border > 0.0 ? report.flapResonators : report.clacResonators);
             break;
-          case 1:
+          case sound::EventKind::Friction:
             ++report.frictionEvents;
             for (const auto& q : r.resonators)
               ++(q.border > 0.0 ? report.freeFriction : report.constrainedFriction);
@@ -251,7 +215,7 @@ std::string eventTimeline(const std::string& cachePath) {
       out << line;
       for (const auto& q : e.resonators) {
         std::snprintf(line, sizeof line, " %.1f %.1f %.0f%s", 100.0 * q.ruling, 100.0 * q.border,
-                      1e4 * q.area, e.kind == 0 ? (q.border > 0.0 ? " flap" : " clac") : "");
+                      1e4 * q.area, e.kind == sound::EventKind::Crumpling ? (q.border > 0.0 ? " flap" : " clac") : "");
         out << line << ";";
       }
       out << "\n";

@@ -20,10 +20,10 @@
 #include <string>
 #include <vector>
 
+#include "crumple/cache/pcache_tear.hpp"
 #include "crumple/core/error.hpp"
 #include "crumple/exporters/gltf_export.hpp"
 #include "crumple/exporters/mesh_export.hpp"
-#include "crumple/exporters/pcache_tear.hpp"
 #include "crumple/exporters/png.hpp"
 #include "temp_dir.hpp"
 

@@ -10,12 +10,12 @@
 #include <cstdint>
 #include <vector>
 
+#include "crumple/cache/pcache.hpp"
+#include "crumple/cache/pcache_contacts.hpp"
+#include "crumple/cache/pcache_sound.hpp"
+#include "crumple/cache/pcache_tear.hpp"
 #include "crumple/core/crc32.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache.hpp"
-#include "crumple/exporters/pcache_contacts.hpp"
-#include "crumple/exporters/pcache_sound.hpp"
-#include "crumple/exporters/pcache_tear.hpp"
 #include "fuzz_input.hpp"
 #include "fuzz_pcache.hpp"
 
@@ -23,35 +23,21 @@ namespace {
 
 void readEverything(const crumple::cache::CacheReader& reader) {
   namespace cache = crumple::cache;
+  using crumple::fuzz::tolerateDamage;
   const cache::CacheHeader& header = reader.header();
-  try {
-    (void)cache::decodeColliders(header.extensions);
-  } catch (const crumple::CorruptDataError&) {
-  }
-  try {
-    (void)cache::decodeSoundSetup(header.extensions);
-  } catch (const crumple::CorruptDataError&) {
-  }
+  tolerateDamage([&] { return cache::decodeColliders(header.extensions); });
+  tolerateDamage([&] { return cache::decodeSoundSetup(header.extensions); });
   (void)reader.verifyAll();
   for (std::size_t i = 0; i < reader.frameCount(); ++i) {
     (void)reader.frameNumber(i);
     (void)reader.topologySource(i);
-    try {
+    tolerateDamage([&] {
       const cache::FrameRecord frame = reader.readFrame(i);
-      try {
-        (void)cache::decodeTearAtlas(frame.extensions);
-      } catch (const crumple::CorruptDataError&) {
-      }
-      try {
-        (void)cache::decodeContacts(frame.extensions);
-      } catch (const crumple::CorruptDataError&) {
-      }
-      try {
-        (void)cache::decodeSoundEvents(frame.extensions);
-      } catch (const crumple::CorruptDataError&) {
-      }
-    } catch (const crumple::CorruptDataError&) {
-    }
+      tolerateDamage([&] { return cache::decodeTearAtlas(frame.extensions); });
+      tolerateDamage([&] { return cache::decodeContacts(frame.extensions); });
+      tolerateDamage([&] { return cache::decodeSoundEvents(frame.extensions); });
+      return 0;
+    });
   }
 }
 
@@ -68,8 +54,6 @@ void readCache(const std::uint8_t* data, std::size_t size) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  readCache(data, size);
-  const std::vector<std::uint8_t> fixed = crumple::fuzz::withValidCrcs(data, size);
-  if (!std::equal(fixed.begin(), fixed.end(), data)) readCache(fixed.data(), fixed.size());
+  crumple::fuzz::asGivenAndWithValidCrcs(data, size, readCache);
   return 0;
 }

@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "crumple/cache/pcache.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/export.hpp"
 #include "crumple/pipeline/inspect.hpp"
@@ -102,8 +102,6 @@ void useCache(const std::uint8_t* data, std::size_t size) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  useCache(data, size);
-  const std::vector<std::uint8_t> fixed = crumple::fuzz::withValidCrcs(data, size);
-  if (!std::equal(fixed.begin(), fixed.end(), data)) useCache(fixed.data(), fixed.size());
+  crumple::fuzz::asGivenAndWithValidCrcs(data, size, useCache);
   return 0;
 }

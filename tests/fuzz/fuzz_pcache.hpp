@@ -2,11 +2,13 @@
 // Shared by the cache fuzz targets (docs/FUZZING.md): an input with the CRC
 // of every chunk recomputed, so that mutated bytes reach the decoders and the
 // tools behind them instead of stopping at the CRC check.
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include "crumple/core/crc32.hpp"
+#include "crumple/core/error.hpp"
 
 namespace crumple::fuzz {
 
@@ -33,6 +35,24 @@ inline std::vector<std::uint8_t> withValidCrcs(const std::uint8_t* data, std::si
     offset = end + kCrc;
   }
   return bytes;
+}
+
+// Runs `use` on the input, and again with every chunk's CRC recomputed when
+// that changes it.
+template <typename Use>
+void asGivenAndWithValidCrcs(const std::uint8_t* data, std::size_t size, Use use) {
+  use(data, size);
+  const std::vector<std::uint8_t> fixed = withValidCrcs(data, size);
+  if (!std::equal(fixed.begin(), fixed.end(), data)) use(fixed.data(), fixed.size());
+}
+
+// Runs a decoder for which damage (CorruptDataError) is an expected outcome.
+template <typename Decode>
+void tolerateDamage(Decode decode) {
+  try {
+    (void)decode();
+  } catch (const crumple::CorruptDataError&) {
+  }
 }
 
 }  // namespace crumple::fuzz

@@ -18,11 +18,11 @@
 #include <string>
 #include <vector>
 
+#include "crumple/cache/pcache.hpp"
+#include "crumple/cache/pcache_contacts.hpp"
+#include "crumple/cache/pcache_sound.hpp"
+#include "crumple/cache/pcache_tear.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache.hpp"
-#include "crumple/exporters/pcache_contacts.hpp"
-#include "crumple/exporters/pcache_sound.hpp"
-#include "crumple/exporters/pcache_tear.hpp"
 #include "crumple/io/animation.hpp"
 #include "crumple/io/scene.hpp"
 
@@ -231,8 +231,8 @@ TEST(FuzzSeeds, CacheWithEverySubBlockReadsBack) {
   patch.polygon = {Vec2(0, 0), Vec2(1, 0), Vec2(0, 1)};
   patch.rect = {0, 0, 2, 2, Vec2(-0.5, -0.5)};
   atlas.patches = {patch};
-  cache::SoundEventRecord event;
-  event.kind = 0;
+  crumple::sound::SoundEvent event;
+  event.kind = crumple::sound::EventKind::Crumpling;
   event.amplitude = 1e-4;
   event.position = Vec3(0.05, 0, -0.05);
   event.resonators = {{0.05, 0.02, 1e-3, Vec3(0.05, 0, -0.05), Vec3::UnitY(), 0.02}};

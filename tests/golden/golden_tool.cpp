@@ -6,7 +6,7 @@
 #include <exception>
 #include <string>
 
-#include "crumple/exporters/pcache.hpp"
+#include "crumple/cache/pcache.hpp"
 
 int main(int argc, char** argv) {
   using namespace crumple;

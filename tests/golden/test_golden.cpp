@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "crumple/cache/pcache.hpp"
 #include "crumple/core/parallel.hpp"
-#include "crumple/exporters/pcache.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/shot.hpp"
@@ -70,6 +70,11 @@ GoldenFrame loadFrame(const std::string& sample, int width, int height) {
   return g;
 }
 
+// What the renderers draw of the golden frame.
+pipeline::FrameView viewOf(const GoldenFrame& g) {
+  return pipeline::FrameViewBuilder(g.scene, g.headerBlocks).build(g.frame);
+}
+
 std::string outPath(const std::string& name) {
   return std::string(CRUMPLE_GOLDEN_OUT_DIR) + "/" + name;
 }
@@ -79,8 +84,7 @@ class Golden : public ::testing::TestWithParam<std::string> {};
 TEST_P(Golden, OsmesaIsByteExact) {
   const std::string sample = GetParam();
   const GoldenFrame g = loadFrame(sample, kWidth, kHeight);
-  const pipeline::FrameViewBuilder views(g.scene, g.headerBlocks);
-  const auto fv = views.build(g.frame);
+  const pipeline::FrameView fv = viewOf(g);
   render::OsmesaRenderer renderer(kWidth, kHeight);
   const ImageRGBA8 image = renderer.render(fv.scene, fv.sheet);
   const std::string golden = std::string(CRUMPLE_GOLDEN_DIR) + "/osmesa/" + sample + ".png";
@@ -103,8 +107,7 @@ TEST_P(Golden, OsmesaIsByteExact) {
 TEST_P(Golden, EmbreeIsWithinToleranceAndThreadIndependent) {
   const std::string sample = GetParam();
   const GoldenFrame g = loadFrame(sample, kWidth, kHeight);
-  const pipeline::FrameViewBuilder views(g.scene, g.headerBlocks);
-  const auto fv = views.build(g.frame);
+  const pipeline::FrameView fv = viewOf(g);
   render::EmbreeRenderer renderer;
   render::PathTraceSettings settings;
   settings.samplesPerPixel = kEmbreeSpp;
@@ -139,8 +142,7 @@ TEST_P(Golden, EmbreeIsWithinToleranceAndThreadIndependent) {
 TEST_P(Golden, BackendsAgreeOnTheAlbedoPass) {
   const std::string sample = GetParam();
   const GoldenFrame g = loadFrame(sample, kAgreeWidth, kAgreeHeight);
-  const pipeline::FrameViewBuilder views(g.scene, g.headerBlocks);
-  const auto fv = views.build(g.frame);
+  const pipeline::FrameView fv = viewOf(g);
   render::OsmesaRenderer osmesa(kAgreeWidth, kAgreeHeight);
   const ImageRGBA8 a = osmesa.render(fv.scene, fv.sheet, nullptr, render::RenderPass::Albedo);
   render::EmbreeRenderer embree;

@@ -643,17 +643,31 @@ TEST(ConeFit, RefitIsStableWhenRepeated) {
               2.0);
 }
 
+// Two cones joined on the generator x = 5 cm of a strip: left of it a cone
+// with pattern apex (5, -15) cm below the sheet, right of it one with apex
+// (5, 30) cm above it.
+struct TwoCones {
+  DevelopedCone left{Vec2(0.05, -0.15), 0.3};
+  DevelopedCone right{Vec2(0.05, 0.3), 0.3, -Vec2::UnitY()};
+  Vec3 embed(const Vec2& p) const { return p.x() <= 0.05 ? left.embed(p) : right.embed(p); }
+  // The strip's ruling positions, x from 2 to 8 cm every 5 mm.
+  std::vector<double> rulingXs() const {
+    std::vector<double> xs;
+    for (int k = 0; k <= 12; ++k) xs.push_back(0.02 + 0.005 * k);
+    return xs;
+  }
+};
+
 TEST(ConeFit, RefitOfTwoConesJoinedOnAGeneratorMeshesEachCone) {
   // Left of x = 5 cm the strip is a cone with pattern apex (5, -15) cm below
   // the sheet, right of it one with apex (5, 30) cm above it; both contain
   // the vertical generator x = 5 cm with the same tangent plane (C1,
   // developable).
-  const DevelopedCone left{Vec2(0.05, -0.15), 0.3};
-  const DevelopedCone right{Vec2(0.05, 0.3), 0.3, -Vec2::UnitY()};
-  const auto embed = [&](const Vec2& p) { return p.x() <= 0.05 ? left.embed(p) : right.embed(p); };
-  std::vector<double> xs;
-  for (int k = 0; k <= 12; ++k) xs.push_back(0.02 + 0.005 * k);
-  StripSheet sheet = makeStrip(xs, embed);
+  const TwoCones cones;
+  const DevelopedCone& left = cones.left;
+  const DevelopedCone& right = cones.right;
+  const auto embed = [&](const Vec2& p) { return cones.embed(p); };
+  StripSheet sheet = makeStrip(cones.rulingXs(), embed);
   GeometricMesh& g = sheet.g;
   ASSERT_EQ(validate(g), "");
   const BoundaryCurve curve = outlineCurve(g, embed);
@@ -726,12 +740,9 @@ TEST(ConeFit, RefitOfTwoConesJoinedOnAGeneratorMeshesEachCone) {
 }
 
 TEST(ConeFit, RefitOfTwoConesWithTheDefaultToleranceStaysValid) {
-  const DevelopedCone left{Vec2(0.05, -0.15), 0.3};
-  const DevelopedCone right{Vec2(0.05, 0.3), 0.3, -Vec2::UnitY()};
-  const auto embed = [&](const Vec2& p) { return p.x() <= 0.05 ? left.embed(p) : right.embed(p); };
-  std::vector<double> xs;
-  for (int k = 0; k <= 12; ++k) xs.push_back(0.02 + 0.005 * k);
-  StripSheet sheet = makeStrip(xs, embed);
+  const TwoCones cones;
+  const auto embed = [&](const Vec2& p) { return cones.embed(p); };
+  StripSheet sheet = makeStrip(cones.rulingXs(), embed);
   GeometricMesh& g = sheet.g;
   const BoundaryCurve curve = outlineCurve(g, embed);
   const double twistBefore = maxQuadTwist(g, 1);

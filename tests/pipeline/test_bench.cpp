@@ -9,16 +9,13 @@
 #include <sstream>
 
 #include "bench_harness.hpp"
-#include "crumple/exporters/pcache.hpp"
+#include "crumple/cache/pcache.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "pareto.hpp"
 #include "test_util.hpp"
 
 using namespace crumple;
-using crumple::testing::readFile;
-using crumple::testing::runCrumple;
-using crumple::testing::sourcePath;
-using crumple::testing::TempDir;
+using namespace crumple::testing;  // the shared helpers (test_util.hpp)
 
 namespace {
 

@@ -15,14 +15,11 @@
 #include <string>
 #include <thread>
 
-#include "crumple/exporters/pcache.hpp"
+#include "crumple/cache/pcache.hpp"
 #include "test_util.hpp"
 
 using namespace crumple;
-using crumple::testing::readFile;
-using crumple::testing::runCrumple;
-using crumple::testing::sourcePath;
-using crumple::testing::TempDir;
+using namespace crumple::testing;  // the shared helpers (test_util.hpp)
 namespace fs = std::filesystem;
 
 namespace {

@@ -345,6 +345,16 @@ class BadInput : public ::testing::Test {
     EXPECT_FALSE(fs::exists(tmp_ / "out/cache.pcache"));
     EXPECT_FALSE(fs::exists(tmp_ / "out/frames/0001.png"));
   }
+  // The small scene with `from` replaced by `to` in its scene.toml must be
+  // rejected, the output naming `mentions`.
+  void expectEditRejected(const std::string& from, const std::string& to,
+                          const std::vector<std::string>& mentions) {
+    writeSmallScene(tmp_ / "s");
+    auto scene = smallSceneToml();
+    scene.replace(scene.find(from), from.size(), to);
+    writeFile(tmp_ / "s/scene.toml", scene);
+    expectRejected("run " + (tmp_ / "s").string(), mentions);
+  }
   TempDir tmp_;
 };
 
@@ -359,11 +369,7 @@ TEST_F(BadInput, MalformedGltf) {
 }
 
 TEST_F(BadInput, MissingHandleNode) {
-  writeSmallScene(tmp_ / "s");
-  auto scene = smallSceneToml();
-  scene.replace(scene.find("node = \"B\""), 10, "node = \"Nobody\"");
-  writeFile(tmp_ / "s/scene.toml", scene);
-  expectRejected("run " + (tmp_ / "s").string(), {"scene.toml", "Nobody"});
+  expectEditRejected("node = \"B\"", "node = \"Nobody\"", {"scene.toml", "Nobody"});
 }
 
 TEST_F(BadInput, NanKeyframe) {
@@ -380,11 +386,7 @@ TEST_F(BadInput, UnknownTomlKey) {
 }
 
 TEST_F(BadInput, NegativeSheetSize) {
-  writeSmallScene(tmp_ / "s");
-  auto scene = smallSceneToml();
-  scene.replace(scene.find("width = 10.0"), 12, "width = -10.0");
-  writeFile(tmp_ / "s/scene.toml", scene);
-  expectRejected("run " + (tmp_ / "s").string(), {"scene.toml", "width"});
+  expectEditRejected("width = 10.0", "width = -10.0", {"scene.toml", "width"});
 }
 
 TEST_F(BadInput, UnwritableOutputFolder) {

@@ -12,9 +12,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "crumple/cache/pcache.hpp"
+#include "crumple/cache/pcache_contacts.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache.hpp"
-#include "crumple/exporters/pcache_contacts.hpp"
 #include "crumple/io/animation.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/contacts.hpp"
@@ -22,8 +22,7 @@
 #include "test_util.hpp"
 
 using namespace crumple;
-using crumple::testing::sourcePath;
-using crumple::testing::TempDir;
+using namespace crumple::testing;  // the shared helpers (test_util.hpp)
 
 namespace {
 

@@ -14,9 +14,9 @@
 #include <numbers>
 #include <numeric>
 
+#include "crumple/cache/pcache.hpp"
 #include "crumple/core/debug.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/inspect.hpp"
@@ -25,8 +25,7 @@
 #include "test_util.hpp"
 
 using namespace crumple;
-using crumple::testing::sourcePath;
-using crumple::testing::TempDir;
+using namespace crumple::testing;  // the shared helpers (test_util.hpp)
 
 namespace {
 

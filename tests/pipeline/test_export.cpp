@@ -17,8 +17,8 @@
 #include <regex>
 #include <set>
 
-#include "crumple/exporters/pcache.hpp"
-#include "crumple/exporters/pcache_tear.hpp"
+#include "crumple/cache/pcache.hpp"
+#include "crumple/cache/pcache_tear.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/export.hpp"
@@ -28,11 +28,7 @@
 #include "test_util.hpp"
 
 using namespace crumple;
-using crumple::testing::readFile;
-using crumple::testing::runCrumple;
-using crumple::testing::simulateSample;
-using crumple::testing::sourcePath;
-using crumple::testing::TempDir;
+using namespace crumple::testing;  // the shared helpers (test_util.hpp)
 namespace fs = std::filesystem;
 
 namespace {

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "crumple/exporters/pcache.hpp"
+#include "crumple/cache/pcache.hpp"
 #include "test_util.hpp"
 
 namespace crumple::testing {

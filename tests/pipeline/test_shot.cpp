@@ -6,10 +6,10 @@
 #include <cstring>
 #include <vector>
 
+#include "crumple/cache/pcache.hpp"
+#include "crumple/cache/pcache_contacts.hpp"
 #include "crumple/core/error.hpp"
 #include "crumple/core/parallel.hpp"
-#include "crumple/exporters/pcache.hpp"
-#include "crumple/exporters/pcache_contacts.hpp"
 #include "crumple/io/animation.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/model/handle_rig.hpp"

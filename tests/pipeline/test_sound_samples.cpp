@@ -12,8 +12,8 @@
 #include <map>
 #include <numbers>
 
-#include "crumple/exporters/pcache.hpp"
-#include "crumple/exporters/pcache_sound.hpp"
+#include "crumple/cache/pcache.hpp"
+#include "crumple/cache/pcache_sound.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/pipeline/shot.hpp"
@@ -26,18 +26,14 @@
 #include "test_util.hpp"
 
 using namespace crumple;
-using crumple::testing::readFile;
-using crumple::testing::runCrumple;
-using crumple::testing::simulateSample;
-using crumple::testing::sourcePath;
-using crumple::testing::TempDir;
+using namespace crumple::testing;  // the shared helpers (test_util.hpp)
 namespace fs = std::filesystem;
 
 namespace {
 
 struct CachedEvents {
   std::vector<int> frames;  // frame number per cached frame
-  std::vector<std::vector<cache::SoundEventRecord>> events;
+  std::vector<std::vector<sound::SoundEvent>> events;
   double fps = 24.0;
 };
 
@@ -50,7 +46,7 @@ CachedEvents readEvents(const std::string& cachePath) {
     const auto frame = reader.readFrame(i);
     out.frames.push_back(frame.frame);
     out.events.push_back(cache::decodeSoundEvents(frame.extensions)
-                             .value_or(std::vector<cache::SoundEventRecord>{}));
+                             .value_or(std::vector<sound::SoundEvent>{}));
   }
   return out;
 }
@@ -66,7 +62,7 @@ Census crumplingCensus(const CachedEvents& c, int from = -1, int to = 1 << 30) {
   for (std::size_t i = 0; i < c.frames.size(); ++i) {
     if (c.frames[i] < from || c.frames[i] > to) continue;
     for (const auto& e : c.events[i]) {
-      if (e.kind != 0) continue;
+      if (e.kind != sound::EventKind::Crumpling) continue;
       ++s.events;
       for (const auto& r : e.resonators) {
         if (r.border > 0.0) {
@@ -171,8 +167,8 @@ TEST(SoundSamples, SlideOnTableRubsWhileSlidingAndFlapsWhenTheBackStandsUp) {
     const int f = c.frames[i];
     int friction = 0, flaps = 0, clacs = 0;
     for (const auto& e : c.events[i]) {
-      if (e.kind == 1) ++friction;
-      if (e.kind != 0) continue;
+      if (e.kind == sound::EventKind::Friction) ++friction;
+      if (e.kind != sound::EventKind::Crumpling) continue;
       for (const auto& r : e.resonators) {
         (r.border > 0.0 ? flaps : clacs) += 1;
         if (f >= 48 && f <= 60) longestBorder = std::max(longestBorder, r.border);
@@ -277,8 +273,8 @@ TEST(SoundSamples, AFasterTearIsLouderAndCracklesMore) {
     for (std::size_t i = 0; i < c.frames.size(); ++i) {
       frames[i].listener = Vec3(0.06, 0.065, 0.3);  // the samples' camera, 30 cm in front
       for (const auto& e : c.events[i])
-        if (e.kind == 2) {
-          frames[i].events.push_back(pipeline::soundEventOf(e));
+        if (e.kind == sound::EventKind::Tearing) {
+          frames[i].events.push_back(e);
           length += e.amplitude * e.duration;
           time += e.duration;
         }

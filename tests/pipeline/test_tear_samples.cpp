@@ -11,8 +11,8 @@
 #include <map>
 #include <numbers>
 
-#include "crumple/exporters/pcache.hpp"
-#include "crumple/exporters/pcache_tear.hpp"
+#include "crumple/cache/pcache.hpp"
+#include "crumple/cache/pcache_tear.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/pipeline/inspect.hpp"
@@ -23,8 +23,7 @@
 #include "test_util.hpp"
 
 using namespace crumple;
-using crumple::testing::sourcePath;
-using crumple::testing::TempDir;
+using namespace crumple::testing;  // the shared helpers (test_util.hpp)
 
 namespace {
 

@@ -28,12 +28,7 @@
 namespace crumple::render {
 namespace {
 
-using test::bentScene;
-using test::bentSceneSheet;
-using test::flatSheet;
-using test::kSheetHeight;
-using test::kSheetWidth;
-using test::topCamera;
+using namespace test;  // the shared scenes and helpers
 
 bool envFlag(const char* name) {
   const char* v = std::getenv(name);
@@ -141,6 +136,19 @@ struct ThreadCountGuard {
 };
 
 // --- radiometry -----------------------------------------------------------------
+
+// An n x n white texture, transparent where both texel coordinates are in
+// [lo, hi): a square hole.
+ImageRGBA8 textureWithHole(int n, int lo, int hi) {
+  ImageRGBA8 tex(n, n);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      std::uint8_t* p = tex.at(x, y);
+      p[0] = p[1] = p[2] = 255;
+      p[3] = (x >= lo && x < hi && y >= lo && y < hi) ? 0 : 255;
+    }
+  return tex;
+}
 
 TEST(EmbreeRenderer, DirectionalLightGivesIntensityTimesCosine) {
   EmbreeRenderer r;
@@ -345,13 +353,7 @@ TEST(EmbreeRenderer, AlphaCutOutShowsTheLitGroundAndNothingElseChanges) {
   s.lights = {directional(Vec3(0.0, -1.0, 0.0), 0.9)};
   const mesh::SheetMesh sheet = flatSheet(0.01);
   // A 32x32 texture over the sheet; texels 8..23 in both directions cut.
-  ImageRGBA8 tex(32, 32);
-  for (int y = 0; y < 32; ++y)
-    for (int x = 0; x < 32; ++x) {
-      std::uint8_t* p = tex.at(x, y);
-      p[0] = p[1] = p[2] = 255;
-      p[3] = (x >= 8 && x < 24 && y >= 8 && y < 24) ? 0 : 255;
-    }
+  const ImageRGBA8 tex = textureWithHole(32, 8, 24);
   const PathTraceSettings ps = settings(4, 0);
   s.paper.texture = tex;
   const ImageRGBAF cut = r.render(s, sheet, ps);
@@ -407,13 +409,7 @@ TEST(EmbreeRenderer, AlphaCutOutLetsLightThroughOnlyTheHole) {
   // The sheet 5 cm up, a hole in the middle; the camera looks at the ground
   // under it from the side, between sheet and ground.
   const mesh::SheetMesh sheet = flatSheet(0.05);
-  ImageRGBA8 tex(4, 4);
-  for (int y = 0; y < 4; ++y)
-    for (int x = 0; x < 4; ++x) {
-      std::uint8_t* p = tex.at(x, y);
-      p[0] = p[1] = p[2] = 255;
-      p[3] = (x == 1 || x == 2) && (y == 1 || y == 2) ? 0 : 255;
-    }
+  const ImageRGBA8 tex = textureWithHole(4, 1, 3);
   s.paper.texture = tex;
   s.camera = Camera::lookAt(Vec3(0.25, 0.04, 0.0), Vec3(0.0, 0.0, 0.0), Vec3::UnitY(), 0.5, 96, 72);
   const ImageRGBAF img = r.render(s, sheet, settings(4, 0));

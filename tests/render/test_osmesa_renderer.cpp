@@ -24,14 +24,7 @@
 namespace crumple::render {
 namespace {
 
-using test::bentScene;
-using test::bentSceneSheet;
-using test::flatSheet;
-using test::kSheetHeight;
-using test::kSheetWidth;
-using test::maybeDump;
-using test::pixelAt;
-using test::topCamera;
+using namespace test;  // the shared scenes and helpers
 
 ImageRGBA8 whiteTexture() {
   ImageRGBA8 t(1, 1);

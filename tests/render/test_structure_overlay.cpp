@@ -21,15 +21,7 @@
 namespace crumple::render {
 namespace {
 
-using test::bentScene;
-using test::bentSceneSheet;
-using test::bentSheetStructure;
-using test::flatSheet;
-using test::kSheetHeight;
-using test::kSheetWidth;
-using test::maybeDump;
-using test::pixelAt;
-using test::topCamera;
+using namespace test;  // the shared scenes and helpers
 
 // Pattern (u, v) on flatSheet(y) -> world.
 Vec3 onFlatSheet(double u, double v, double y = 0.0) {
@@ -71,6 +63,24 @@ double segmentDistance(const Vec2& q, const Vec2& a, const Vec2& b) {
 }
 
 const StructurePalette kPalette;
+
+// The ruling drawn horizontally from a to b covers lineWidthPx (4) pixels
+// across, column by column: img against the plain render.
+void expectRulingLineWidth(const Camera& camera, const Vec3& a, const Vec3& b,
+                           const ImageRGBA8& plain, const ImageRGBA8& img) {
+  const auto pa = projectToPixel(camera, a), pb = projectToPixel(camera, b);
+  ASSERT_TRUE(pa && pb);
+  const int y0 = static_cast<int>(pa->y());
+  const auto line = srgb(kPalette.ruling);
+  for (int x = static_cast<int>(pa->x()) + 3; x < static_cast<int>(pb->x()) - 3; x += 5) {
+    double coverage = 0.0;
+    for (int y = y0 - 6; y <= y0 + 6; ++y) {
+      const double base = plain.at(x, y)[1], drawn = img.at(x, y)[1];
+      coverage += (base - drawn) / (base - line[1]);  // green: paper high, line 0
+    }
+    EXPECT_NEAR(coverage, 4.0, 0.3) << "column " << x;
+  }
+}
 
 // The 200 x 150 view from above onto the flat test sheet that most property
 // tests below share, with an empty overlay to fill in.
@@ -130,18 +140,7 @@ TEST_F(StructureOverlayTopView, LineMidpointHasTheLinesColourAndItsWidth) {
   EXPECT_LE(colorDistance(pixelAt(img, scene.camera, 0.5 * (c + d)), srgb(kPalette.border)), 1);
 
   // Coverage across the horizontal line, column by column: lineWidthPx.
-  const auto pa = projectToPixel(scene.camera, a), pb = projectToPixel(scene.camera, b);
-  ASSERT_TRUE(pa && pb);
-  const int y0 = static_cast<int>(pa->y());
-  const auto line = srgb(kPalette.ruling);
-  for (int x = static_cast<int>(pa->x()) + 3; x < static_cast<int>(pb->x()) - 3; x += 5) {
-    double coverage = 0.0;
-    for (int y = y0 - 6; y <= y0 + 6; ++y) {
-      const double base = plain.at(x, y)[1], drawn = img.at(x, y)[1];
-      coverage += (base - drawn) / (base - line[1]);  // green: paper high, line 0
-    }
-    EXPECT_NEAR(coverage, 4.0, 0.3) << "column " << x;
-  }
+  expectRulingLineWidth(scene.camera, a, b, plain, img);
 }
 
 TEST(StructureOverlay, LinesStayWholeOnATiltedSurfaceAndHiddenBehindThePaper) {
@@ -163,18 +162,7 @@ TEST(StructureOverlay, LinesStayWholeOnATiltedSurfaceAndHiddenBehindThePaper) {
   const ImageRGBA8 img = r.render(scene, sheet, &o);
   const ImageRGBA8 plain = r.render(scene, sheet);
   maybeDump("overlay_tilted", img);
-  const auto pa = projectToPixel(scene.camera, a), pb = projectToPixel(scene.camera, b);
-  ASSERT_TRUE(pa && pb);
-  const int y0 = static_cast<int>(pa->y());
-  const auto line = srgb(kPalette.ruling);
-  for (int x = static_cast<int>(pa->x()) + 3; x < static_cast<int>(pb->x()) - 3; x += 5) {
-    double coverage = 0.0;
-    for (int y = y0 - 6; y <= y0 + 6; ++y) {
-      const double base = plain.at(x, y)[1], drawn = img.at(x, y)[1];
-      coverage += (base - drawn) / (base - line[1]);
-    }
-    EXPECT_NEAR(coverage, 4.0, 0.3) << "column " << x;
-  }
+  expectRulingLineWidth(scene.camera, a, b, plain, img);
   const auto ph = projectToPixel(scene.camera, 0.5 * (hiddenA + hiddenB));
   ASSERT_TRUE(ph.has_value());
   for (int y = static_cast<int>(ph->y()) - 4; y <= static_cast<int>(ph->y()) + 4; ++y)

@@ -156,12 +156,18 @@ ContactOptions collide(const ColliderSet* set, double distance) {
 
 const PinFunction kNoPins = [](double, std::vector<Pin>& out) { out.clear(); };
 
-TEST(Contacts, ASheetDroppedOnATableComesToRestOnIt) {
-  const Material paper;
+// A 2 cm-meshed sheet colliding with `table`, the plane y = 0.
+ElasticSheet sheetOverTable(const Material& paper, ColliderSet& table) {
   ElasticSheet sheet(flatSheet(0.02), paper, SimParams{});
-  ColliderSet table;
   table.add("table", ColliderShape{}, at(Vec3::Zero()));
   sheet.setContacts(collide(&table, paper.thickness));
+  return sheet;
+}
+
+TEST(Contacts, ASheetDroppedOnATableComesToRestOnIt) {
+  const Material paper;
+  ColliderSet table;
+  ElasticSheet sheet = sheetOverTable(paper, table);
   const double dt = 1.0 / 96.0;
   double lowest = 1.0;
   for (int step = 0; step < 96; ++step) {  // 1 s: falls 2 cm in ~64 ms, then rests
@@ -202,10 +208,8 @@ TEST(Contacts, ASheetDrapesOverASphereWithoutEnteringIt) {
 
 TEST(Contacts, WithoutCollidersTheSheetFallsThrough) {
   const Material paper;
-  ElasticSheet sheet(flatSheet(0.02), paper, SimParams{});
   ColliderSet table;
-  table.add("table", ColliderShape{}, at(Vec3::Zero()));
-  sheet.setContacts(collide(&table, paper.thickness));
+  ElasticSheet sheet = sheetOverTable(paper, table);
   sheet.setContacts({});  // switched off again
   for (int step = 0; step < 48; ++step) sheet.advance(step / 96.0, 1.0 / 96.0, kNoPins);
   EXPECT_LT(sheet.positions()[0].y(), -0.1);

@@ -342,15 +342,26 @@ TEST(ElasticSheet, FreeFallIsExactWithoutDamping) {
               1e-9);
 }
 
-TEST(ElasticSheet, HingeSettlesAtItsRestAngle) {
-  // Two triangles: pin triangle A, let the wing vertex of B find the rest
-  // angle (no gravity). Checks the sign convention end to end.
+namespace {
+
+// Two triangles sharing the hinge 0-1 along the x axis, in the plane z = 0:
+// wing 2 at (0.01, 0.015), wing 3 at `wing`.
+mesh::SheetMesh twoTriangles(const Vec2& wing) {
   mesh::SheetMesh m;
-  m.pattern = {Vec2(0, 0), Vec2(0.02, 0), Vec2(0.01, 0.015), Vec2(0.01, -0.015)};
+  m.pattern = {Vec2(0, 0), Vec2(0.02, 0), Vec2(0.01, 0.015), wing};
   m.triangles = {{0, 1, 2}, {1, 0, 3}};
   m.regionOfTriangle = {0, 0};
   m.regionTypes = {mesh::RegionType::Flat};
   mesh::placePattern(m, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
+  return m;
+}
+
+}  // namespace
+
+TEST(ElasticSheet, HingeSettlesAtItsRestAngle) {
+  // Two triangles: pin triangle A, let the wing vertex of B find the rest
+  // angle (no gravity). Checks the sign convention end to end.
+  const mesh::SheetMesh m = twoTriangles(Vec2(0.01, -0.015));
   SimParams p;
   p.gravity = Vec3::Zero();
   p.massDamping = 5.0;
@@ -402,18 +413,9 @@ TEST(ElasticSheet, RejectsBadInput) {
 
 namespace {
 
-// Two triangles sharing the hinge 0-1 along the x axis, in the plane z = 0.
-// The wings differ (2 at (0.01, 0.015), 3 at (0.008, -0.013)) so that
-// wing 3 never lands on wing 2 when it is rotated about the hinge.
-mesh::SheetMesh twoTriangleHinge() {
-  mesh::SheetMesh m;
-  m.pattern = {Vec2(0, 0), Vec2(0.02, 0), Vec2(0.01, 0.015), Vec2(0.008, -0.013)};
-  m.triangles = {{0, 1, 2}, {1, 0, 3}};
-  m.regionOfTriangle = {0, 0};
-  m.regionTypes = {mesh::RegionType::Flat};
-  mesh::placePattern(m, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY());
-  return m;
-}
+// The hinge mesh of the stiffness tests below (two different wings, so that
+// wing 3 never lands on wing 2 when it is rotated about the hinge).
+mesh::SheetMesh twoTriangleHinge() { return twoTriangles(Vec2(0.008, -0.013)); }
 
 // The mesh's positions with wing 3 rigidly rotated by `phi` about the hinge
 // (the x axis), towards -z for phi > 0: the fold angle is phi.

@@ -20,10 +20,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-using crumple::testing::DatabaseScratch;
-using crumple::testing::writeClip;
-using crumple::testing::writeDatabase;
-using crumple::testing::writeSpectrum;
+using namespace crumple::testing;  // the shared helpers (test_util.hpp)
 using Scratch = DatabaseScratch;
 
 // Replaces the first `from` in DIR/index.toml by `to`.

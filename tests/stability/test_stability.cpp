@@ -21,8 +21,8 @@
 #include <vector>
 
 #include "../pipeline/test_util.hpp"
+#include "crumple/cache/pcache.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/pipeline/inspect.hpp"
 

@@ -10,8 +10,8 @@
 #include <iostream>
 #include <numbers>
 
+#include "crumple/cache/pcache_tear.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache_tear.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/mesh/tear_patches.hpp"
 #include "crumple/pipeline/shot.hpp"

@@ -5,34 +5,22 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 #include "crumple/core/error.hpp"
 
 namespace crumple::io::detail {
 
 const char* typeName(const toml::node& n) {
-  switch (n.type()) {
-    case toml::node_type::table:
-      return "a table";
-    case toml::node_type::array:
-      return "an array";
-    case toml::node_type::string:
-      return "a string";
-    case toml::node_type::integer:
-      return "an integer";
-    case toml::node_type::floating_point:
-      return "a float";
-    case toml::node_type::boolean:
-      return "a boolean";
-    case toml::node_type::date:
-      return "a date";
-    case toml::node_type::time:
-      return "a time";
-    case toml::node_type::date_time:
-      return "a date-time";
-    default:
-      return "nothing";
-  }
+  static constexpr std::pair<toml::node_type, const char*> kNames[] = {
+      {toml::node_type::table, "a table"},       {toml::node_type::array, "an array"},
+      {toml::node_type::string, "a string"},     {toml::node_type::integer, "an integer"},
+      {toml::node_type::floating_point, "a float"}, {toml::node_type::boolean, "a boolean"},
+      {toml::node_type::date, "a date"},         {toml::node_type::time, "a time"},
+      {toml::node_type::date_time, "a date-time"}};
+  for (const auto& [type, name] : kNames)
+    if (n.type() == type) return name;
+  return "nothing";
 }
 
 namespace {

@@ -7,6 +7,25 @@
 
 namespace crumple::mesh {
 
+namespace {
+
+// Index of the point nearest to p (lowest index on ties; -1 for none).
+template <typename Point>
+int nearestPoint(const std::vector<Point>& points, const Point& p) {
+  int best = -1;
+  double bestD = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double d = (points[i] - p).squaredNorm();
+    if (d < bestD) {
+      bestD = d;
+      best = static_cast<int>(i);
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
 std::vector<MeshEdge> buildEdges(const SheetMesh& mesh) {
   struct HalfEdge {
     int a, b, tri, opp;
@@ -85,16 +104,7 @@ void placePattern(SheetMesh& mesh, const Vec3& origin, const Vec3& uAxis, const 
 }
 
 int nearestPatternVertex(const SheetMesh& mesh, const Vec2& p) {
-  int best = -1;
-  double bestD = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < mesh.pattern.size(); ++i) {
-    const double d = (mesh.pattern[i] - p).squaredNorm();
-    if (d < bestD) {
-      bestD = d;
-      best = static_cast<int>(i);
-    }
-  }
-  return best;
+  return nearestPoint(mesh.pattern, p);
 }
 
 PatternLocation locatePattern(const SheetMesh& mesh, const Vec2& p) {
@@ -113,18 +123,7 @@ PatternLocation locatePattern(const SheetMesh& mesh, const Vec2& p) {
   return {};
 }
 
-int nearestVertex(const SheetMesh& mesh, const Vec3& p) {
-  int best = -1;
-  double bestD = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
-    const double d = (mesh.positions[i] - p).squaredNorm();
-    if (d < bestD) {
-      bestD = d;
-      best = static_cast<int>(i);
-    }
-  }
-  return best;
-}
+int nearestVertex(const SheetMesh& mesh, const Vec3& p) { return nearestPoint(mesh.positions, p); }
 
 std::vector<int> vertexNeighbours(const SheetMesh& mesh, int v) {
   std::vector<int> out;

@@ -143,15 +143,24 @@ double srgb8ToLinear(std::uint8_t srgb) {
   return s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4);
 }
 
-ImageRGBAF decodeSrgb8(const ImageRGBA8& image, bool premultiply) {
-  // srgb8ToLinear of every 8-bit level, rounded to float once.
-  static const std::array<float, 256> kLinear = [] {
+namespace {
+
+// srgb8ToLinear of every 8-bit level, rounded to float once.
+const std::array<float, 256>& linearOfSrgb8() {
+  static const std::array<float, 256> table = [] {
     std::array<float, 256> t{};
     for (int i = 0; i < 256; ++i)
       t[static_cast<std::size_t>(i)] =
           static_cast<float>(srgb8ToLinear(static_cast<std::uint8_t>(i)));
     return t;
   }();
+  return table;
+}
+
+}  // namespace
+
+ImageRGBAF decodeSrgb8(const ImageRGBA8& image, bool premultiply) {
+  const std::array<float, 256>& kLinear = linearOfSrgb8();
   ImageRGBAF out(image.width, image.height);
   for (int y = 0; y < image.height; ++y)
     for (int x = 0; x < image.width; ++x) {
@@ -198,13 +207,7 @@ std::vector<std::array<Vec3, 3>> shadingNormals(const std::vector<Vec3>& positio
 Vec4 sampleTexture(const ImageRGBA8& texture, const Vec2& uv) {
   const int w = texture.width, h = texture.height;
   if (w <= 0 || h <= 0) return Vec4(1.0, 1.0, 1.0, 1.0);
-  static const std::array<float, 256> kDecode = [] {
-    std::array<float, 256> t{};
-    for (int i = 0; i < 256; ++i)
-      t[static_cast<std::size_t>(i)] =
-          static_cast<float>(srgb8ToLinear(static_cast<std::uint8_t>(i)));
-    return t;
-  }();
+  const std::array<float, 256>& kDecode = linearOfSrgb8();
   const double x = uv.x() * w - 0.5, y = uv.y() * h - 0.5;
   const double fx = std::floor(x), fy = std::floor(y);
   const double ax = x - fx, ay = y - fy;

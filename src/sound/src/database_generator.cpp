@@ -373,15 +373,23 @@ void writeSpectrum(const fs::path& path, const std::vector<float>& power, const 
   if (!out) throw std::runtime_error(path.string() + ": cannot write the spectrum");
 }
 
+// The checked cell's random stream for a clip (kind 0) or a friction
+// spectrum (kind 1): a constrained resonator (border 0) draws the same
+// stream whatever its ruling length.
+CounterRng cellRng(const DatabaseModel& model, int kind, double ruling, double border,
+                   int variant) {
+  validate(model);
+  validateCell(ruling, border, variant);
+  return border == 0.0 ? variantRng(model, kind, 0.0, 0.0, variant)
+                       : variantRng(model, kind, ruling, border, variant);
+}
+
 }  // namespace
 
 std::vector<float> crumplingClip(const DatabaseModel& model, double ruling, double border,
                                  int variant) {
-  validate(model);
-  validateCell(ruling, border, variant);
+  const CounterRng rng = cellRng(model, 0, ruling, border, variant);
   const bool clac = border == 0.0;
-  const CounterRng rng = clac ? variantRng(model, 0, 0.0, 0.0, variant)
-                              : variantRng(model, 0, ruling, border, variant);
   const double seconds = clac ? model.clacLength : model.flapLength;
   std::vector<double> y(static_cast<std::size_t>(std::llround(seconds * model.sampleRate)), 0.0);
   addModes(clac ? clacModes(model, rng) : flapModes(model, ruling, border, rng), model.sampleRate,
@@ -394,11 +402,8 @@ std::vector<float> crumplingClip(const DatabaseModel& model, double ruling, doub
 
 std::vector<float> frictionSpectrum(const DatabaseModel& model, double ruling, double border,
                                     int variant) {
-  validate(model);
-  validateCell(ruling, border, variant);
+  const CounterRng rng = cellRng(model, 1, ruling, border, variant);
   const bool constrained = border == 0.0;
-  const CounterRng rng = constrained ? variantRng(model, 1, 0.0, 0.0, variant)
-                                     : variantRng(model, 1, ruling, border, variant);
   const std::size_t bins = static_cast<std::size_t>(model.fftSize / 2 + 1);
   const double binHz = static_cast<double>(model.sampleRate) / model.fftSize;
   const double level = model.constrainedPower * (1.0 + 0.1 * (rng.uniform(1) - 0.5));

@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
+#include "crumple/cache/pcache.hpp"
 #include "crumple/core/image.hpp"
 #include "crumple/core/types.hpp"
-#include "crumple/exporters/pcache.hpp"
 
 namespace crumple::exporters {
 

@@ -4,8 +4,8 @@
 // the depth measure the acceptance asks for at every frame.
 #include <vector>
 
-#include "crumple/exporters/pcache.hpp"
-#include "crumple/exporters/pcache_contacts.hpp"
+#include "crumple/cache/pcache.hpp"
+#include "crumple/cache/pcache_contacts.hpp"
 #include "crumple/io/animation.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/sim/colliders.hpp"

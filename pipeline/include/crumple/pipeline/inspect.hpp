@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "crumple/exporters/pcache.hpp"
-#include "crumple/exporters/pcache_structure.hpp"
+#include "crumple/cache/pcache.hpp"
+#include "crumple/cache/pcache_structure.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
 
 namespace crumple::pipeline {

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "crumple/cache/pcache.hpp"
 #include "crumple/core/types.hpp"
-#include "crumple/exporters/pcache.hpp"
 
 namespace crumple::pipeline {
 

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "crumple/exporters/pcache.hpp"
+#include "crumple/cache/pcache.hpp"
 #include "crumple/io/animation.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "crumple/exporters/pcache_sound.hpp"
+#include "crumple/cache/pcache_sound.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/sound/events.hpp"
 
@@ -51,10 +51,6 @@ struct SoundReport {
   double synthesisMs = 0.0;        // the mix, without reading the cache or writing files
   std::vector<std::string> notes;  // e.g. a cache recovered without its footer
 };
-
-// A sound event and its cache record (SEVT), both ways.
-sound::SoundEvent soundEventOf(const cache::SoundEventRecord& record);
-cache::SoundEventRecord soundEventRecord(const sound::SoundEvent& event);
 
 // The default database folder: $CRUMPLE_ASSETS/sound/default, else the
 // source tree's assets/sound/default.

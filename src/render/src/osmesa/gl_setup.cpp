@@ -28,18 +28,21 @@ using gl::Vertex;
 
 namespace {
 
+// Enables float attribute `index` of `components` at `offset` in buffers of
+// VertexType on the bound array.
+template <typename VertexType>
+void floatAttribute(GLuint index, GLint components, std::size_t offset) {
+  glEnableVertexAttribArray(index);
+  glVertexAttribPointer(index, components, GL_FLOAT, GL_FALSE,
+                        static_cast<GLsizei>(sizeof(VertexType)),
+                        reinterpret_cast<const void*>(offset));
+}
+
 // The attribute layout of a Vertex buffer (position, normal, uv) on the bound array.
 void setupVertexLayout() {
-  const auto stride = static_cast<GLsizei>(sizeof(Vertex));
-  glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride,
-                        reinterpret_cast<const void*>(offsetof(Vertex, pos)));
-  glEnableVertexAttribArray(1);
-  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride,
-                        reinterpret_cast<const void*>(offsetof(Vertex, normal)));
-  glEnableVertexAttribArray(2);
-  glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride,
-                        reinterpret_cast<const void*>(offsetof(Vertex, uv)));
+  floatAttribute<Vertex>(0, 3, offsetof(Vertex, pos));
+  floatAttribute<Vertex>(1, 3, offsetof(Vertex, normal));
+  floatAttribute<Vertex>(2, 2, offsetof(Vertex, uv));
 }
 
 }  // namespace
@@ -126,21 +129,10 @@ void OsmesaRenderer::Impl::createGeometry() {
   glGenBuffers(1, &patchVbo);
   glBindVertexArray(patchVao);
   glBindBuffer(GL_ARRAY_BUFFER, patchVbo);
-  {
-    const auto stride = static_cast<GLsizei>(sizeof(PatchVertex));
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride,
-                          reinterpret_cast<const void*>(offsetof(PatchVertex, pos)));
-    glEnableVertexAttribArray(1);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride,
-                          reinterpret_cast<const void*>(offsetof(PatchVertex, normal)));
-    glEnableVertexAttribArray(2);
-    glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride,
-                          reinterpret_cast<const void*>(offsetof(PatchVertex, uv)));
-    glEnableVertexAttribArray(3);
-    glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, stride,
-                          reinterpret_cast<const void*>(offsetof(PatchVertex, maskUv)));
-  }
+  floatAttribute<PatchVertex>(0, 3, offsetof(PatchVertex, pos));
+  floatAttribute<PatchVertex>(1, 3, offsetof(PatchVertex, normal));
+  floatAttribute<PatchVertex>(2, 2, offsetof(PatchVertex, uv));
+  floatAttribute<PatchVertex>(3, 2, offsetof(PatchVertex, maskUv));
 
   glGenVertexArrays(1, &overlayVao);
   glGenBuffers(1, &overlayVbo);

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "crumple/cache/pcache_structure.hpp"
 #include "crumple/core/state_io.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
@@ -46,13 +47,9 @@ struct ModelContext {
   std::function<void(const paper::ProjectionInput&)> projectionProbe;
 };
 
-// The crumpling model's structure changes of one frame (the cache's STRC
-// block; paper Sec. 5-6).
-struct StructureChanges {
-  std::uint32_t singularFromFlat = 0, singularFromRuling = 0;
-  std::uint32_t curvedFromCompression = 0, curvedFromFolding = 0;
-  std::uint32_t creases = 0, flatSplits = 0, curvedFlattened = 0, undoneByStretch = 0;
-};
+// The crumpling model's structure changes of one frame: the cache's STRC
+// record (paper Sec. 5-6), defined once with its codec.
+using StructureChanges = cache::StructureChanges;
 
 // What one frame's advance did: the run summary's counters.
 struct FrameStats {

@@ -9,9 +9,9 @@
 #include <stdexcept>
 #include <thread>
 
+#include "crumple/cache/pcache.hpp"
 #include "crumple/core/crc32.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache.hpp"
 #include "temp_dir.hpp"
 
 namespace crumple::cache {

@@ -11,7 +11,7 @@
 #include <optional>
 #include <vector>
 
-#include "crumple/exporters/pcache.hpp"
+#include "crumple/cache/pcache.hpp"
 
 namespace crumple::cache {
 
@@ -44,6 +44,23 @@ struct StructureChanges {
 
 // The number of fields this version writes and reads.
 inline constexpr std::uint32_t kStructureFields = 8;
+
+// The fields in the block's order, each with its name in `crumple inspect
+// --json` (docs/CRUMPLING.md "Structure changes per frame").
+struct StructureField {
+  const char* name;
+  std::uint32_t StructureChanges::*count;
+};
+inline constexpr std::array<StructureField, kStructureFields> kStructureFieldList{{
+    {"singular_from_flat", &StructureChanges::singularFromFlat},
+    {"singular_from_ruling", &StructureChanges::singularFromRuling},
+    {"curved_from_compression", &StructureChanges::curvedFromCompression},
+    {"curved_from_folding", &StructureChanges::curvedFromFolding},
+    {"creases", &StructureChanges::creases},
+    {"flat_splits", &StructureChanges::flatSplits},
+    {"curved_flattened", &StructureChanges::curvedFlattened},
+    {"undone_by_stretch", &StructureChanges::undoneByStretch},
+}};
 
 // The sub-block: u32 field count, then that many u32 counts.
 ExtensionBlock encodeStructureChanges(const StructureChanges& changes);

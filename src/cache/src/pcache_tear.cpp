@@ -1,6 +1,6 @@
 // The TEAR extension sub-block. Byte layout: docs/PCACHE.md ("Sub-blocks
 // written by crumple").
-#include "crumple/exporters/pcache_tear.hpp"
+#include "crumple/cache/pcache_tear.hpp"
 
 #include <bit>
 #include <cstdint>
@@ -8,14 +8,11 @@
 #include <string>
 #include <utility>
 
-#include "block_reader.hpp"
-#include "byte_encoder.hpp"
+#include "sub_block.hpp"
 
 namespace crumple::cache {
 namespace {
 
-using detail::Bytes;
-using detail::Encoder;
 using Reader = detail::SubBlockReader;
 
 // Smallest encoded patch: 2 i32, 2 u8, u32 + 3 points, 4 u32, 2 f64.
@@ -27,17 +24,17 @@ ExtensionBlock encodeTearAtlas(const mesh::TearAtlas& atlas) {
   if (const std::string problem = mesh::validate(atlas); !problem.empty())
     throw std::invalid_argument("encodeTearAtlas: " + problem);
   Bytes bytes;
-  Encoder w(bytes);
+  ByteWriter w(bytes);
   w.f64(atlas.texelSize);
   w.u32(static_cast<std::uint32_t>(atlas.width));
   w.u32(static_cast<std::uint32_t>(atlas.height));
-  w.count(atlas.patches.size(), "tear patches");
+  w.count32(atlas.patches.size(), "tear patches");
   for (const mesh::TearPatch& p : atlas.patches) {
     w.i32(p.triangle);
     w.i32(p.tear);
     w.u8(static_cast<std::uint8_t>(p.side));
     w.u8(p.lipEdges);
-    w.count(p.polygon.size(), "tear patch polygon points");
+    w.count32(p.polygon.size(), "tear patch polygon points");
     for (const Vec2& q : p.polygon) {
       w.f64(q.x());
       w.f64(q.y());
@@ -75,7 +72,7 @@ std::optional<mesh::TearAtlas> decodeTearAtlas(const std::vector<ExtensionBlock>
            " beyond 2^31 - 1");
   atlas.width = static_cast<int>(width);
   atlas.height = static_cast<int>(height);
-  atlas.patches.resize(r.count(kMinPatchBytes, "patch count"));
+  atlas.patches.resize(r.count32(kMinPatchBytes, "patch count"));
   for (std::size_t i = 0; i < atlas.patches.size(); ++i) {
     mesh::TearPatch& p = atlas.patches[i];
     r.at("patch", i);
@@ -83,7 +80,7 @@ std::optional<mesh::TearAtlas> decodeTearAtlas(const std::vector<ExtensionBlock>
     p.tear = r.i32("tear");
     p.side = static_cast<mesh::LipSide>(r.u8("side"));
     p.lipEdges = r.u8("lip edges");
-    p.polygon.resize(r.count(16, "polygon point count"));
+    p.polygon.resize(r.count32(16, "polygon point count"));
     for (Vec2& q : p.polygon) {
       q.x() = r.f64("polygon point");
       q.y() = r.f64("polygon point");
@@ -104,7 +101,7 @@ std::optional<mesh::TearAtlas> decodeTearAtlas(const std::vector<ExtensionBlock>
   if (texels / 8 + (texels % 8 != 0) != r.remaining())
     r.fail(std::to_string(r.remaining()) + " bytes for " + std::to_string(width) + " x " +
            std::to_string(height) + " texels (one bit each)");
-  const std::uint8_t* bits = r.raw(r.remaining(), "mask");
+  const std::uint8_t* bits = r.take(r.remaining(), "mask");
   atlas.mask.resize(static_cast<std::size_t>(texels));
   for (std::size_t i = 0; i < atlas.mask.size(); ++i)
     atlas.mask[i] = (bits[i / 8] >> (i % 8)) & 1u ? 255 : 0;

@@ -1,4 +1,4 @@
-// The TEAR sub-block (exporters/pcache_tear.hpp, docs/PCACHE.md): a frame's
+// The TEAR sub-block (cache/pcache_tear.hpp, docs/PCACHE.md): a frame's
 // tear atlas round-trips exactly, and damaged blocks are rejected.
 #include <gtest/gtest.h>
 
@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "crumple/cache/pcache.hpp"
+#include "crumple/cache/pcache_tear.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache.hpp"
-#include "crumple/exporters/pcache_tear.hpp"
 #include "temp_dir.hpp"
 
 namespace crumple::cache {

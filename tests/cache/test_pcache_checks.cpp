@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "crumple/cache/pcache.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache.hpp"
 #include "temp_dir.hpp"
 
 namespace crumple::cache {

@@ -1,4 +1,4 @@
-// The COLL / CONT sub-blocks (exporters/pcache_contacts.hpp, docs/PCACHE.md).
+// The COLL / CONT sub-blocks (cache/pcache_contacts.hpp, docs/PCACHE.md).
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "crumple/cache/pcache.hpp"
+#include "crumple/cache/pcache_contacts.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache.hpp"
-#include "crumple/exporters/pcache_contacts.hpp"
 #include "temp_dir.hpp"
 
 namespace crumple::cache {
@@ -233,9 +233,9 @@ TEST(PcacheContacts, MalformedCollidersThrow) {
   corrupt("friction cut short", "collider 1: friction truncated", [](Bytes& b) { b.pop_back(); });
   corrupt("material cut short", "collider 1: material",
           [](Bytes& b) { b.resize(rec1 + 4 + 4 + 2); });
-  corrupt("name length past the end", "collider 1: name: length",
+  corrupt("name length past the end", "collider 1: name 1000 runs past the end",
           [&](Bytes& b) { setU32(b, rec1, 1000); });
-  corrupt("name length -1", "collider 0: name: length 4294967295",
+  corrupt("name length -1", "collider 0: name 4294967295 runs past the end",
           [&](Bytes& b) { setU32(b, 4, 0xFFFFFFFFu); });
   corrupt("trailing byte", "1 trailing bytes", [](Bytes& b) { b.push_back('!'); });
   corrupt("fewer colliders than stored", "trailing bytes", [](Bytes& b) { setU32(b, 0, 1); });

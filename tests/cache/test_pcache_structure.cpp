@@ -1,4 +1,4 @@
-// The STRC sub-block (exporters/pcache_structure.hpp, docs/PCACHE.md): the
+// The STRC sub-block (cache/pcache_structure.hpp, docs/PCACHE.md): the
 // documented layout, a newer writer's extra fields and an older writer's
 // fewer, and malformed blocks.
 #include <gtest/gtest.h>
@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "crumple/cache/pcache_structure.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache_structure.hpp"
 
 namespace crumple::cache {
 namespace {

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "crumple/exporters/pcache.hpp"
+#include "crumple/cache/pcache.hpp"
 
 namespace crumple::cache {
 

@@ -10,7 +10,7 @@
 #include <optional>
 #include <vector>
 
-#include "crumple/exporters/pcache.hpp"
+#include "crumple/cache/pcache.hpp"
 #include "crumple/mesh/tear_patches.hpp"
 
 namespace crumple::cache {

@@ -1,6 +1,6 @@
 // The COLL and CONT extension sub-blocks. Byte layout: docs/PCACHE.md
 // ("Sub-blocks written by crumple").
-#include "crumple/exporters/pcache_contacts.hpp"
+#include "crumple/cache/pcache_contacts.hpp"
 
 #include <bit>
 #include <cmath>
@@ -10,9 +10,8 @@
 #include <stdexcept>
 #include <utility>
 
-#include "block_reader.hpp"
-#include "byte_encoder.hpp"
 #include "crumple/core/error.hpp"
+#include "sub_block.hpp"
 
 namespace crumple::cache {
 namespace {
@@ -23,15 +22,15 @@ static_assert(std::numeric_limits<double>::is_iec559 && sizeof(double) == 8,
               "doubles are stored as IEEE-754 binary64");
 static_assert(sizeof(int) == 4, "ints are stored as 32-bit two's complement");
 
-using detail::Bytes;
-using detail::Encoder;
 
 // Smallest encoded record: a collider with two empty strings (2 u32 + f64),
 // a contact (2 i32 + 2 f32).
 constexpr std::size_t kMinColliderBytes = 4 + 4 + 8;
 constexpr std::size_t kContactBytes = 4 + 4 + 4 + 4;
 
-using detail::findOneBlock;
+using detail::decodeBlock;
+using detail::readRecords;
+using detail::writeRecords;
 using Reader = detail::SubBlockReader;
 
 bool finiteNonNegative(double v) { return std::isfinite(v) && v >= 0.0; }
@@ -64,71 +63,55 @@ std::string frictionProblem(double friction) {
 
 ExtensionBlock encodeColliders(const std::vector<ColliderInfo>& colliders) {
   Bytes bytes;
-  Encoder w(bytes);
-  w.count(colliders.size(), "colliders");
-  for (std::size_t i = 0; i < colliders.size(); ++i) {
-    const auto& c = colliders[i];
-    if (const auto problem = frictionProblem(c.friction); !problem.empty())
-      throw std::invalid_argument("encodeColliders: collider " + std::to_string(i) + " ('" +
-                                  c.name + "'): " + problem);
-    w.str(c.name, "bytes in a collider name");
-    w.str(c.material, "bytes in a collider material");
+  ByteWriter w(bytes);
+  const auto problem = [](const ColliderInfo& c) {
+    const std::string p = frictionProblem(c.friction);
+    return p.empty() ? p : "'" + c.name + "': " + p;
+  };
+  writeRecords(w, colliders, "encodeColliders", "collider", problem, [&](const ColliderInfo& c) {
+    w.str32(c.name, "bytes in a collider name");
+    w.str32(c.material, "bytes in a collider material");
     w.f64(c.friction);
-  }
+  });
   return {kCollidersTag, std::move(bytes)};
 }
 
 ExtensionBlock encodeContacts(const std::vector<ContactRecord>& contacts) {
   Bytes bytes;
-  Encoder w(bytes);
-  w.count(contacts.size(), "contacts");
-  for (std::size_t i = 0; i < contacts.size(); ++i) {
-    const auto& c = contacts[i];
-    if (const auto problem = contactProblem(c); !problem.empty())
-      throw std::invalid_argument("encodeContacts: contact " + std::to_string(i) + ": " + problem);
-    w.i32(c.vertex);
-    w.i32(c.collider);
-    w.f32(c.slideSpeed);
-    w.f32(c.normalForce);
-  }
+  ByteWriter w(bytes);
+  writeRecords(w, contacts, "encodeContacts", "contact", contactProblem,
+               [&](const ContactRecord& c) {
+                 w.i32(c.vertex);
+                 w.i32(c.collider);
+                 w.f32(c.slideSpeed);
+                 w.f32(c.normalForce);
+               });
   return {kContactsTag, std::move(bytes)};
 }
 
 std::optional<std::vector<ColliderInfo>> decodeColliders(
     const std::vector<ExtensionBlock>& headerBlocks) {
-  const ExtensionBlock* block = findOneBlock(headerBlocks, kCollidersTag);
-  if (!block) return std::nullopt;
-  Reader r(block->data, "COLL");
-  std::vector<ColliderInfo> colliders(r.count(kMinColliderBytes, "collider count"));
-  for (std::size_t i = 0; i < colliders.size(); ++i) {
-    auto& c = colliders[i];
-    r.at("collider", i);
-    c.name = r.str("name");
-    c.material = r.str("material");
-    c.friction = r.f64("friction");
-    if (const auto problem = frictionProblem(c.friction); !problem.empty()) r.fail(problem);
-  }
-  r.expectEnd();
-  return colliders;
+  return decodeBlock(headerBlocks, kCollidersTag, [](Reader& r) {
+    return readRecords<ColliderInfo>(r, kMinColliderBytes, "collider", [&](ColliderInfo& c) {
+      c.name = r.str32("name");
+      c.material = r.str32("material");
+      c.friction = r.f64("friction");
+      if (const auto problem = frictionProblem(c.friction); !problem.empty()) r.fail(problem);
+    });
+  });
 }
 
 std::optional<std::vector<ContactRecord>> decodeContacts(
     const std::vector<ExtensionBlock>& frameBlocks) {
-  const ExtensionBlock* block = findOneBlock(frameBlocks, kContactsTag);
-  if (!block) return std::nullopt;
-  Reader r(block->data, "CONT");
-  std::vector<ContactRecord> contacts(r.count(kContactBytes, "contact count"));
-  for (std::size_t i = 0; i < contacts.size(); ++i) {
-    auto& c = contacts[i];
-    r.at("contact", i);
-    c.vertex = r.i32("vertex");
-    c.collider = r.i32("collider");
-    c.slideSpeed = r.f32("slide speed");
-    c.normalForce = r.f32("normal force");
-    if (const auto problem = contactProblem(c); !problem.empty()) r.fail(problem);
-  }
-  r.expectEnd();
-  return contacts;
+  return decodeBlock(frameBlocks, kContactsTag, [](Reader& r) {
+    return readRecords<ContactRecord>(r, kContactBytes, "contact", [&](ContactRecord& c) {
+      c.vertex = r.i32("vertex");
+      c.collider = r.i32("collider");
+      c.slideSpeed = r.f32("slide speed");
+      c.normalForce = r.f32("normal force");
+      if (const auto problem = contactProblem(c); !problem.empty()) r.fail(problem);
+    });
+  });
 }
 
 }  // namespace crumple::cache

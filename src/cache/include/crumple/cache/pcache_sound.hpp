@@ -12,8 +12,9 @@
 #include <optional>
 #include <vector>
 
+#include "crumple/cache/pcache.hpp"
 #include "crumple/core/types.hpp"
-#include "crumple/exporters/pcache.hpp"
+#include "crumple/sound/event_types.hpp"
 
 namespace crumple::cache {
 
@@ -32,32 +33,14 @@ struct SoundSetupRecord {
   bool operator==(const SoundSetupRecord&) const = default;
 };
 
-struct ResonatorRecord {
-  double ruling = 0.0;  // l_r (m)
-  double border = 0.0;  // l_c (m), 0: constrained
-  double area = 0.0;    // m^2
-  Vec3 centre = Vec3::Zero();
-  Vec3 normal = Vec3::UnitY();
-  double radius = 0.0;  // m
-  bool operator==(const ResonatorRecord&) const = default;
-};
-
-struct SoundEventRecord {
-  std::uint8_t kind = 0;  // sound::EventKind: 0 crumpling, 1 friction, 2 tearing
-  int tear = -1;          // tearing: the tear; else -1
-  double amplitude = 0.0;
-  double duration = 0.0;  // tearing: the advance's time (s), ending at the frame
-  Vec3 position = Vec3::Zero();
-  Vec3 normal = Vec3::UnitY();
-  std::vector<ResonatorRecord> resonators;
-  bool operator==(const SoundEventRecord&) const = default;
-};
+// The frame block stores sound::SoundEvent as the sound module defines it
+// (crumple/sound/event_types.hpp, header-only).
 
 // Throw std::invalid_argument for a value the decoder would reject: a kind
 // above 2, a non-finite value, a negative amplitude, size or radius, or a
 // tear below -1, a negative duration; std::length_error for more than 2^32 - 1 records.
 ExtensionBlock encodeSoundSetup(const SoundSetupRecord& setup);                 // tag "SNDS"
-ExtensionBlock encodeSoundEvents(const std::vector<SoundEventRecord>& events);  // tag "SEVT"
+ExtensionBlock encodeSoundEvents(const std::vector<sound::SoundEvent>& events);  // tag "SEVT"
 
 // nullopt when no block carries the tag (a cache made without [sound]; a
 // frame without SEVT in a cache with SNDS had no event). Throw
@@ -65,7 +48,7 @@ ExtensionBlock encodeSoundEvents(const std::vector<SoundEventRecord>& events);  
 // data: truncated, trailing bytes, a count larger than the block can hold,
 // a second block with the same tag, or a value the encoder refuses.
 std::optional<SoundSetupRecord> decodeSoundSetup(const std::vector<ExtensionBlock>& headerBlocks);
-std::optional<std::vector<SoundEventRecord>> decodeSoundEvents(
+std::optional<std::vector<sound::SoundEvent>> decodeSoundEvents(
     const std::vector<ExtensionBlock>& frameBlocks);
 
 }  // namespace crumple::cache

@@ -1,4 +1,4 @@
-// The SNDS / SEVT sub-blocks (exporters/pcache_sound.hpp, docs/PCACHE.md).
+// The SNDS / SEVT sub-blocks (cache/pcache_sound.hpp, docs/PCACHE.md).
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -8,26 +8,26 @@
 #include <stdexcept>
 #include <vector>
 
+#include "crumple/cache/pcache_sound.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache_sound.hpp"
 
 namespace crumple::cache {
 namespace {
 
-std::vector<SoundEventRecord> someEvents() {
-  SoundEventRecord crumpling;
-  crumpling.kind = 0;
+std::vector<sound::SoundEvent> someEvents() {
+  sound::SoundEvent crumpling;
+  crumpling.kind = sound::EventKind::Crumpling;
   crumpling.amplitude = 2.5e-3;
   crumpling.position = Vec3(0.1, -0.2, 1.0 / 3.0);
   crumpling.normal = Vec3(0.0, 0.0, 1.0);
   crumpling.resonators = {{0.1, 0.0, 0.01, Vec3(1, 2, 3), Vec3(0, 1, 0), 0.056},
                           {0.125, 0.3, 0.02, Vec3(-1, 0, 0.5), Vec3(1, 0, 0), 0.08}};
-  SoundEventRecord friction;
-  friction.kind = 1;
+  sound::SoundEvent friction;
+  friction.kind = sound::EventKind::Friction;
   friction.amplitude = 0.07;
   friction.resonators = {{0.05, 0.1, 0.004, Vec3::Zero(), Vec3::UnitY(), 0.035}};
-  SoundEventRecord tearing;
-  tearing.kind = 2;
+  sound::SoundEvent tearing;
+  tearing.kind = sound::EventKind::Tearing;
   tearing.tear = 7;
   tearing.amplitude = std::numeric_limits<double>::denorm_min();
   tearing.duration = 0.125;
@@ -86,7 +86,7 @@ TEST(PcacheSound, MalformedBlocksThrowNamingTheRecord) {
 
 TEST(PcacheSound, EncodersRejectWhatTheDecoderWould) {
   auto events = someEvents();
-  events[0].kind = 4;
+  events[0].kind = static_cast<sound::EventKind>(4);
   EXPECT_THROW(encodeSoundEvents(events), std::invalid_argument);
   events = someEvents();
   events[1].resonators[0].area = -1.0;

@@ -7,9 +7,9 @@
 #include <numbers>
 #include <string>
 
+#include "crumple/cache/pcache.hpp"
+#include "crumple/cache/pcache_contacts.hpp"
 #include "crumple/core/error.hpp"
-#include "crumple/exporters/pcache.hpp"
-#include "crumple/exporters/pcache_contacts.hpp"
 
 namespace crumple::cache {
 namespace {
