@@ -18,6 +18,8 @@ import sys
 
 # The repository's root: write_sample names a script by its path from here.
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# The samples' key rate: every frame at 24 fps and every half frame.
+KEYS_PER_SECOND = 48
 
 
 # ---- easing and quaternions ----
@@ -58,13 +60,31 @@ def qrot(q, v):
     return tuple(v[i] + 2.0 * w * c1[i] + 2.0 * c2[i] for i in range(3))
 
 
-# ---- keys ----
-def key_times(t_end, keys_per_second):
+# ---- motions and their keys ----
+def squeeze_and_pinch(a, b, side, d_squeeze, d_pinch):
+    """One corner of a square sheet (side metres) held at its corners, whose
+    held sides come closer by the fraction d_squeeze and whose border
+    through this corner is then compressed by the fraction d_pinch (0 for a
+    border left alone). (a, b): the corner's offset from the sheet's centre
+    across the held sides and along them. Returns (a, b, arch, pinch): the
+    moved offset, each side moving half the compression, and the turns of
+    the corner's tangent plane that bow the sheet as a smooth sine arch,
+    2 sqrt(delta) for a compression fraction delta (the end slope of the arch
+    w = A sin(pi x / L) whose extra length is delta), signed by the side
+    (arch with a, pinch with b). The caller turns the tangent plane by them
+    about its own axes."""
+    arch = math.copysign(2.0 * math.sqrt(d_squeeze), a)
+    pinch = math.copysign(2.0 * math.sqrt(d_pinch), b)
+    return (a - math.copysign(side * d_squeeze / 2.0, a),
+            b - math.copysign(side * d_pinch / 2.0, b), arch, pinch)
+
+
+def key_times(t_end, keys_per_second=KEYS_PER_SECOND):
     """The key times from 0 to t_end (included), keys_per_second a second."""
     return [k / keys_per_second for k in range(int(round(t_end * keys_per_second)) + 1)]
 
 
-def handle_tracks(handles, pose, t_end, keys_per_second):
+def handle_tracks(handles, pose, t_end, keys_per_second=KEYS_PER_SECOND):
     """Samples every handle's pose at keys_per_second from 0 to t_end.
     handles: [(node name, u, v)]; pose(u, v, t) -> (position, rotation).
     Returns (times, [(node name, [position], [rotation])]) for write_gltf."""
