@@ -7,7 +7,9 @@ generators share (write_sample: `SCRIPT [OUT.gltf]`).
 Imported by samples/make_tear_gltf.py, samples/*/make_*_gltf.py and
 tests/stability/scenes/make_scenes.py, each of which puts this folder on
 sys.path relative to its own location (so they run from any working
-directory); not a sample itself.
+directory); not a sample itself. samples/drape/make_drape_gltf.py stands
+alone: scripts/reliability_table.py runs an edited copy of its source text,
+where a path relative to the script would not resolve.
 """
 import base64
 import json
