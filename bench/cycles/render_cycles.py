@@ -87,34 +87,32 @@ AREA_POWER_PER_I = 4.0 * math.pi
 WORLD_STRENGTH_PER_RADIANCE = 1.0
 
 
+# The options after Blender's '--': option -> (key in the options, type of
+# its value, default).
+OPTIONS = {
+    "--scene": ("scene", str, None),
+    "--out": ("out", str, None),
+    "--spp": ("spp", int, 16),
+    "--threads": ("threads", int, 1),
+    "--timing": ("timing", str, None),
+    "--max-bounces": ("max_bounces", int, None),
+    "--seed": ("seed", int, None),
+}
+
+
 def parse_args(argv):
-    """The options after Blender's '--'."""
+    """The options after Blender's '--' (OPTIONS), each followed by its
+    value; --scene and --out are required."""
     args = argv[argv.index("--") + 1:] if "--" in argv else []
-    opts = {"scene": None, "out": None, "spp": 16, "threads": 1, "timing": None,
-            "max_bounces": None, "seed": None}
-    i = 0
-    while i < len(args):
-        key = args[i]
+    opts = {key: default for key, _, default in OPTIONS.values()}
+    for i in range(0, len(args), 2):
+        option = args[i]
         if i + 1 >= len(args):
-            raise SystemExit("render_cycles.py: %s needs a value" % key)
-        value = args[i + 1]
-        if key == "--scene":
-            opts["scene"] = value
-        elif key == "--out":
-            opts["out"] = value
-        elif key == "--spp":
-            opts["spp"] = int(value)
-        elif key == "--threads":
-            opts["threads"] = int(value)
-        elif key == "--timing":
-            opts["timing"] = value
-        elif key == "--max-bounces":
-            opts["max_bounces"] = int(value)
-        elif key == "--seed":
-            opts["seed"] = int(value)
-        else:
-            raise SystemExit("render_cycles.py: unknown option " + key)
-        i += 2
+            raise SystemExit("render_cycles.py: %s needs a value" % option)
+        if option not in OPTIONS:
+            raise SystemExit("render_cycles.py: unknown option " + option)
+        key, type_, _ = OPTIONS[option]
+        opts[key] = type_(args[i + 1])
     if not opts["scene"] or not opts["out"]:
         raise SystemExit("render_cycles.py: --scene and --out are required")
     return opts

@@ -32,6 +32,11 @@ import math
 import os
 import sys
 
+# Shared helpers (samples/gltf_anim.py).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from gltf_anim import (add_sphere_meshes, check_no_stretch, key_times, ramp, smoother,  # noqa: E402
+                       write_sample)
+
 # ---- geometry and timing (metres, seconds) ----
 W, D = 0.21, 0.297          # A4, u along X and v along -Z
 C0 = (0.0, 0.30, 0.0)       # the sheet's centre, held by the finger
@@ -57,12 +62,7 @@ MOVES = [
     (2.25, 3.25, R_SWING, 0.075, Z, Z),
 ]
 T_END = 3.75
-KEYS_PER_SECOND = 48
 SPHERE_SEGMENTS = (48, 24)
-
-# Shared helpers (samples/gltf_anim.py).
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from gltf_anim import add_sphere_meshes, check_no_stretch, ramp, smoother, write_gltf  # noqa: E402
 
 
 def hand_offset(t):
@@ -91,7 +91,7 @@ def corner_position(u, v, t):
 
 
 def tracks():
-    times = [k / KEYS_PER_SECOND for k in range(int(round(T_END * KEYS_PER_SECOND)) + 1)]
+    times = key_times(T_END)
     a = [tuple(h + o for h, o in zip(H, hand_offset(t))) for t in times]
     b = [tuple(h - o for h, o in zip(H, hand_offset(t))) for t in times]
     out = [("Pinch", [C0] * len(times), None)]
@@ -122,11 +122,9 @@ def check(times, tracks_):
 
 
 def main():
-    here = os.path.dirname(os.path.abspath(__file__))
-    path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "crumple-ball.gltf")
     times, tr = tracks()
     check(times, tr)
-    write_gltf(path, "crumple samples/crumple-ball/make_crumple_ball_gltf.py", times, tr)
+    path = write_sample(__file__, "crumple-ball.gltf", times, tr)
     add_sphere_meshes(path, [("HandA", R - INSET, None), ("HandB", R - INSET, None)],
                       SPHERE_SEGMENTS)
 

@@ -39,7 +39,7 @@ sides, so singular points keep appearing:
                midpoints -5 degrees (a twist).
   D 2.00-4.00  everything squeezes further in: sx, sz -> 0.45.
   4.00-4.50    hold.
-check() asserts that no two held points (handle vertices and their tangent
+main() asserts that no two held points (handle vertices and their tangent
 neighbours) ever get farther apart than on the pattern: the handles only
 ever compress the sheet, never stretch it. There are no contacts yet
 (README), so the sheet may pass through itself at the end.
@@ -51,6 +51,11 @@ import math
 import os
 import sys
 
+# Shared helpers (samples/gltf_anim.py).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from gltf_anim import (check_no_stretch, cross, handle_tracks, qaxis, qmul, qrot,  # noqa: E402
+                       ramp, write_sample)
+
 # ---- geometry and timing (metres, seconds, radians) ----
 W = 0.10            # sheet side
 Y0 = 0.10           # height of the flat sheet
@@ -59,7 +64,6 @@ T_B = (1.00, 2.50)
 T_C = (2.00, 3.50)
 T_D = (2.00, 4.00)
 T_END = 4.50
-KEYS_PER_SECOND = 48
 DEG = math.pi / 180.0
 
 # (node name, u, v) in metres on the pattern
@@ -100,11 +104,6 @@ plan("C", ("MidF", "MidR", "MidB", "MidL"), yaw=-5 * DEG)  # against the corners
 SPANS = {"A": T_A, "B": T_B, "C": T_C}
 
 
-# Shared helpers (samples/gltf_anim.py).
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from gltf_anim import check_no_stretch, cross, qaxis, qmul, qrot, ramp, smoother, write_gltf  # noqa: E402,F401
-
-
 # ---- the motion ----
 def scales(t):
     a, b, d = ramp(t, T_A), ramp(t, T_B), ramp(t, T_D)
@@ -133,28 +132,13 @@ def handle_pose(name, u, v, t):
     return (p[0], Y0 + total["lift"] + p[1], p[2]), q
 
 
-def tracks():
-    times = [k / KEYS_PER_SECOND for k in range(int(round(T_END * KEYS_PER_SECOND)) + 1)]
-    out = []
-    for name, u, v in HANDLES:
-        poses = [handle_pose(name, u, v, t) for t in times]
-        out.append((name, [p for p, _ in poses], [q for _, q in poses]))
-    return times, out
-
-
-def check(times, tracks_):
-    """No two held points ever get farther apart than on the pattern."""
-    pattern = {name: (u, v) for name, u, v in HANDLES}
-    return check_no_stretch(times, tracks_, pattern, (W, W),
-                            ((1.0, 0.0, 0.0), (0.0, 0.0, -1.0)))
-
-
 def main():
-    here = os.path.dirname(os.path.abspath(__file__))
-    path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "crumple.gltf")
-    times, tr = tracks()
-    check(times, tr)
-    write_gltf(path, "crumple samples/crumple/make_crumple_gltf.py", times, tr)
+    names = {(u, v): name for name, u, v in HANDLES}  # handle_pose finds a handle's PLAN by name
+    times, tracks = handle_tracks(HANDLES, lambda u, v, t: handle_pose(names[(u, v)], u, v, t),
+                                  T_END)
+    # No two held points ever get farther apart than on the pattern.
+    check_no_stretch(times, tracks, HANDLES, (W, W), ((1.0, 0.0, 0.0), (0.0, 0.0, -1.0)))
+    write_sample(__file__, "crumple.gltf", times, tracks)
 
 
 if __name__ == "__main__":

@@ -41,11 +41,16 @@ Motion (times in s):
 Run it to regenerate the file (the committed file is its output):
     python3 samples/cylinder-fold/make_cylinder_fold_gltf.py [OUT.gltf]
 samples/paper-types runs the same motion (make_paper_types_gltf.py imports
-this script's write()).
+this script's tracks()).
 """
 import math
 import os
 import sys
+
+# Shared helpers (samples/gltf_anim.py).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from gltf_anim import (check_no_stretch, handle_tracks, qaxis, qmul, qrot, ramp,  # noqa: E402
+                       write_sample)
 
 # ---- geometry and timing (metres, seconds, radians) ----
 W = 0.10                 # sheet width (u, across the cylinder)
@@ -56,16 +61,10 @@ BETA = math.radians(15)  # final half-angle of the axis bend
 T_WRAP = (0.25, 1.75)
 T_BEND = (2.25, 3.75)
 T_END = 4.25
-KEYS_PER_SECOND = 48
 
 # (node name, u, v) in metres on the pattern
 CORNERS = [("CornerFL", 0.0, 0.0), ("CornerFR", W, 0.0),
            ("CornerBL", 0.0, L), ("CornerBR", W, L)]
-
-
-# Shared helpers (samples/gltf_anim.py).
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from gltf_anim import check_no_stretch, cross, handle_tracks, qaxis, qmul, qrot, ramp, smoother, write_gltf  # noqa: E402,F401
 
 
 # ---- the motion ----
@@ -96,25 +95,15 @@ def corner_pose(u, v, t):
 
 
 def tracks():
-    return handle_tracks(CORNERS, corner_pose, T_END, KEYS_PER_SECOND)
-
-
-def check(times, tracks_):
-    """No two held points ever get farther apart than on the pattern."""
-    pattern = {name: (u, v) for name, u, v in CORNERS}
-    return check_no_stretch(times, tracks_, pattern, (W, L),
-                            ((1.0, 0.0, 0.0), (0.0, 0.0, -1.0)))
-
-
-def write(path, generator="crumple samples/cylinder-fold/make_cylinder_fold_gltf.py"):
-    times, tr = tracks()
-    check(times, tr)
-    write_gltf(path, generator, times, tr)
+    """The corners' keys, (times, tracks) for write_sample, checked: no two
+    held points ever get farther apart than on the pattern."""
+    times, out = handle_tracks(CORNERS, corner_pose, T_END)
+    check_no_stretch(times, out, CORNERS, (W, L), ((1.0, 0.0, 0.0), (0.0, 0.0, -1.0)))
+    return times, out
 
 
 def main():
-    here = os.path.dirname(os.path.abspath(__file__))
-    write(sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "cylinder-fold.gltf"))
+    write_sample(__file__, "cylinder-fold.gltf", *tracks())
 
 
 if __name__ == "__main__":

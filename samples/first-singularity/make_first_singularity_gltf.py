@@ -46,9 +46,13 @@ Motion (times in s):
 Run it to regenerate the file (the committed file is its output):
     python3 samples/first-singularity/make_first_singularity_gltf.py [OUT.gltf]
 """
-import math
 import os
 import sys
+
+# Shared helpers (samples/gltf_anim.py).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from gltf_anim import (check_no_stretch, handle_tracks, qaxis, qmul, ramp,  # noqa: E402
+                       squeeze_and_pinch, write_sample)
 
 # ---- geometry and timing (metres, seconds, radians) ----
 W = 0.10              # sheet side (u and v)
@@ -58,56 +62,32 @@ PINCH = 0.10          # then the left border is compressed by 10 %
 T_SQUEEZE = (0.25, 1.50)
 T_PINCH = (1.75, 3.25)
 T_END = 4.00
-KEYS_PER_SECOND = 48
 
 # (node name, u, v) in metres on the pattern
 CORNERS = [("CornerBL", 0.0, 0.0), ("CornerBR", W, 0.0),
            ("CornerTL", 0.0, W), ("CornerTR", W, W)]
 
 
-# Shared helpers (samples/gltf_anim.py).
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from gltf_anim import check_no_stretch, cross, handle_tracks, qaxis, qmul, qrot, ramp, smoother, write_gltf  # noqa: E402,F401
-
-
 # ---- the motion ----
 def corner_pose(u, v, t):
     """World position and rotation of the handle at pattern point (u, v)."""
-    left = u < W / 2.0
-    bottom = v < W / 2.0
-    d1 = SQUEEZE * ramp(t, T_SQUEEZE)
-    d2 = PINCH * ramp(t, T_PINCH) if left else 0.0
-    x = u - W / 2.0
-    y = v - W / 2.0
     # The sides move towards each other (x); the left border's corners towards
     # each other (y).
-    x -= math.copysign(W * d1 / 2.0, x)
-    y -= math.copysign(W * d2 / 2.0, y)
-    gamma = 2.0 * math.sqrt(d1)  # arch across X: turn the in-sheet direction towards +Z
-    psi = 2.0 * math.sqrt(d2)    # arch along the left border, towards +Z as well
-    q = qaxis((0.0, 1.0, 0.0), -gamma if left else gamma)
-    q = qmul(q, qaxis((1.0, 0.0, 0.0), psi if bottom else -psi))
+    left = u < W / 2.0
+    x, y, gamma, psi = squeeze_and_pinch(u - W / 2.0, v - W / 2.0, W, SQUEEZE * ramp(t, T_SQUEEZE),
+                                         PINCH * ramp(t, T_PINCH) if left else 0.0)
+    # Both arches turn the in-sheet direction towards +Z: gamma the one across
+    # X (about Y), psi the one along the left border (about X, the other way
+    # round).
+    q = qmul(qaxis((0.0, 1.0, 0.0), gamma), qaxis((1.0, 0.0, 0.0), -psi))
     return (x, Y0 + W / 2.0 + y, 0.0), q
 
 
-def tracks():
-    return handle_tracks(CORNERS, corner_pose, T_END, KEYS_PER_SECOND)
-
-
-def check(times, tracks_):
-    """No two held points ever get farther apart than on the pattern."""
-    pattern = {name: (u, v) for name, u, v in CORNERS}
-    return check_no_stretch(times, tracks_, pattern, (W, W),
-                            ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0)))
-
-
 def main():
-    here = os.path.dirname(os.path.abspath(__file__))
-    path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "first-singularity.gltf")
-    times, tr = tracks()
-    check(times, tr)
-    write_gltf(path, "crumple samples/first-singularity/make_first_singularity_gltf.py",
-               times, tr)
+    times, tracks = handle_tracks(CORNERS, corner_pose, T_END)
+    # No two held points ever get farther apart than on the pattern.
+    check_no_stretch(times, tracks, CORNERS, (W, W), ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0)))
+    write_sample(__file__, "first-singularity.gltf", times, tracks)
 
 
 if __name__ == "__main__":

@@ -59,12 +59,14 @@ farther apart than on the pattern).
 Run it to regenerate the file (the committed file is its output):
     python3 samples/fold-over/make_fold_over_gltf.py [OUT.gltf]
 """
-import base64
-import json
 import math
 import os
-import struct
 import sys
+
+# Shared helpers (samples/gltf_anim.py).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from gltf_anim import (add_meshes, check_no_stretch, handle_tracks, qaxis, ramp,  # noqa: E402
+                       write_sample)
 
 # ---- geometry and timing (metres, seconds, radians) ----
 W = 0.15              # sheet length (u, along X)
@@ -89,18 +91,12 @@ T_PRESS = (1.90, 2.50)
 T_RELEASE = 2.75      # the scene's release_time of the right corners
 T_LIFT = (3.25, 4.50)
 T_END = 4.5
-KEYS_PER_SECOND = 48
 
 # (node name, u, v) in metres on the pattern
 CORNERS = [("CornerSW", 0.0, 0.0), ("CornerSE", W, 0.0),
            ("CornerNW", 0.0, D), ("CornerNE", W, D)]
 U_AXIS = (1.0, 0.0, 0.0)
 V_AXIS = (0.0, 0.0, -1.0)
-
-
-# Shared helpers (samples/gltf_anim.py).
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from gltf_anim import check_no_stretch, handle_tracks, qaxis, ramp, write_gltf  # noqa: E402
 
 
 # ---- the motion ----
@@ -133,7 +129,7 @@ def presser_y(t):
 
 
 def tracks():
-    times, out = handle_tracks(CORNERS, corner_pose, T_END, KEYS_PER_SECOND)
+    times, out = handle_tracks(CORNERS, corner_pose, T_END)
     out.append(("Presser", [(PRESS_X, presser_y(t), 0.0) for t in times], None))
     return times, out
 
@@ -152,14 +148,14 @@ def check(times, tracks_):
     assert PLATE[2] > D
     flap = W - U_FOLD - math.pi * R_LOOP
     assert math.hypot(X_FOLD - EDGE_X, 2.0 * R_LOOP) < flap
-    pattern = {name: (u, v) for name, u, v in CORNERS}
-    return check_no_stretch(times, tracks_[:len(CORNERS)], pattern, (W, D), (U_AXIS, V_AXIS))
+    return check_no_stretch(times, tracks_[:len(CORNERS)], CORNERS, (W, D), (U_AXIS, V_AXIS))
 
 
 # ---- the presser's render mesh ----
-def add_presser_mesh(path):
-    """Gives the node Presser a box mesh of the plate's size, its bottom face
-    on the node (in a second embedded buffer), for the scene's mesh prop."""
+def presser_mesh():
+    """The box mesh of the plate's size, its bottom face on the node, as
+    gltf_anim.add_meshes takes it (node Presser, for the scene's mesh
+    prop)."""
     hx, hz = PLATE[0] / 2.0, PLATE[2] / 2.0
     y0, y1 = 0.0, PLATE[1]
     # Six faces, four vertices each (flat normals), counter-clockwise seen
@@ -179,47 +175,13 @@ def add_presser_mesh(path):
             positions.extend(p)
             normals.extend(normal)
         indices.extend((base, base + 1, base + 2, base, base + 2, base + 3))
-    blob = bytearray()
-    blob.extend(struct.pack("<%df" % len(positions), *positions))
-    blob.extend(struct.pack("<%df" % len(normals), *normals))
-    blob.extend(struct.pack("<%dH" % len(indices), *indices))
-    with open(path) as f:
-        gltf = json.load(f)
-    buf = len(gltf["buffers"])
-    gltf["buffers"].append({
-        "byteLength": len(blob),
-        "uri": "data:application/octet-stream;base64," + base64.b64encode(bytes(blob)).decode(),
-    })
-    nv = len(positions) // 3
-    views = [(0, 12 * nv, 34962), (12 * nv, 12 * nv, 34962), (24 * nv, 2 * len(indices), 34963)]
-    first_view = len(gltf["bufferViews"])
-    for offset, length, target in views:
-        gltf["bufferViews"].append({"buffer": buf, "byteOffset": offset, "byteLength": length,
-                                    "target": target})
-    first_acc = len(gltf["accessors"])
-    gltf["accessors"].extend([
-        {"bufferView": first_view, "componentType": 5126, "count": nv, "type": "VEC3",
-         "min": [-hx, y0, -hz], "max": [hx, y1, hz]},
-        {"bufferView": first_view + 1, "componentType": 5126, "count": nv, "type": "VEC3"},
-        {"bufferView": first_view + 2, "componentType": 5123, "count": len(indices), "type": "SCALAR"},
-    ])
-    gltf["meshes"] = [{"name": "Presser", "primitives": [{
-        "attributes": {"POSITION": first_acc, "NORMAL": first_acc + 1},
-        "indices": first_acc + 2, "mode": 4}]}]
-    presser = next(n for n in gltf["nodes"] if n["name"] == "Presser")
-    presser["mesh"] = 0
-    with open(path, "w") as f:
-        json.dump(gltf, f, indent=1)
-        f.write("\n")
+    return ("Presser", positions, normals, indices, ([-hx, y0, -hz], [hx, y1, hz]), None)
 
 
 def main():
-    here = os.path.dirname(os.path.abspath(__file__))
-    path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "fold-over.gltf")
     times, tr = tracks()
     check(times, tr)
-    write_gltf(path, "crumple samples/fold-over/make_fold_over_gltf.py", times, tr)
-    add_presser_mesh(path)
+    add_meshes(write_sample(__file__, "fold-over.gltf", times, tr), [presser_mesh()])
 
 
 if __name__ == "__main__":

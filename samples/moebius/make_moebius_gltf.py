@@ -28,7 +28,7 @@ At s = 1 end B faces end A across a 1 cm gap, upside down: its corner
 v = 0 is next to end A's corner v = 3, which is the Moebius closure (the
 strip is not glued; the handles keep it closed). The arc and the twist ask
 for no stretching: no two handles ever get farther apart than on the
-pattern (check() asserts it).
+pattern (main() asserts it).
 
 Motion (times in s):
   0.00-0.25  rest.
@@ -47,6 +47,11 @@ import math
 import os
 import sys
 
+# Shared helpers (samples/gltf_anim.py).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from gltf_anim import (KEYS_PER_SECOND, check_no_stretch, cross, handle_tracks, qaxis,  # noqa: E402
+                       qmul, qrot, ramp, write_sample)
+
 # ---- geometry and timing (metres, seconds, radians) ----
 LENGTH = 0.24                      # strip length (u), L_paper
 WIDTH = 0.03                       # strip width (v)
@@ -56,7 +61,6 @@ TURN = 0.96 * 2.0 * math.pi        # final turning angle of the loop
 TWIST = math.pi                    # final twist of end B about the strip axis
 T_MOVE = (0.25, 3.75)
 T_END = 4.25
-KEYS_PER_SECOND = 48
 # The camera (node "Camera"): looks at the strip from this direction (from
 # the front, above and to the right), as close as keeps it all in view.
 CAMERA = "Camera"
@@ -76,47 +80,46 @@ CORNERS = [("EndA0", 0.0, 0.0), ("EndA1", 0.0, WIDTH),
            ("EndB0", LENGTH, 0.0), ("EndB1", LENGTH, WIDTH)]
 
 
-# Shared helpers (samples/gltf_anim.py).
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from gltf_anim import check_no_stretch, cross, handle_tracks, qaxis, qmul, qrot, ramp, smoother, write_gltf  # noqa: E402,F401
-
-
 # ---- the motion ----
+def section(s, f):
+    """The strip's cross-section at the fraction f of its length from end A
+    (f = 1: end B) at progress s: its centre on the arc of length LENGTH f
+    and turning angle TURN s f, and its rotation (that turn about +Z, then
+    the twist TWIST s f about the strip axis)."""
+    a = TURN * s * f
+    if a < 1e-9:
+        centre = (X0 + LENGTH * f, Y0, 0.0)
+    else:
+        r = LENGTH * f / a
+        centre = (X0 + r * math.sin(a), Y0 + r * (1.0 - math.cos(a)), 0.0)
+    return centre, qmul(qaxis((0.0, 0.0, 1.0), a), qaxis((1.0, 0.0, 0.0), TWIST * s * f))
+
+
+def on_section(centre, q, across):
+    """The point `across` (in end A's frame, from the centre line) carried
+    to the cross-section (centre, q)."""
+    a = qrot(q, across)
+    return (centre[0] + a[0], centre[1] + a[1], centre[2] + a[2])
+
+
 def corner_pose(u, v, t):
     """World position and rotation of the handle at pattern point (u, v)."""
     across = (0.0, 0.0, WIDTH / 2.0 - v)  # from the centre line to the corner (v = 0 at +Z)
     if u < LENGTH / 2.0:                  # end A: still
         return (X0 + across[0], Y0 + across[1], across[2]), (0.0, 0.0, 0.0, 1.0)
-    s = ramp(t, T_MOVE)
-    theta = TURN * s
-    if theta < 1e-9:
-        centre = (X0 + LENGTH, Y0, 0.0)
-    else:
-        r = LENGTH / theta
-        centre = (X0 + r * math.sin(theta), Y0 + r * (1.0 - math.cos(theta)), 0.0)
-    q = qmul(qaxis((0.0, 0.0, 1.0), theta), qaxis((1.0, 0.0, 0.0), TWIST * s))
-    a = qrot(q, across)
-    return (centre[0] + a[0], centre[1] + a[1], centre[2] + a[2]), q
+    centre, q = section(ramp(t, T_MOVE), 1.0)
+    return on_section(centre, q, across), q
 
 
 def strip_points(t):
     """Points of the strip as the handles shape it at time t: the arc with a
     twist growing along it (the simulated strip stays close to this)."""
     s = ramp(t, T_MOVE)
-    theta = TURN * s
     points = []
     for i in range(25):
-        f = i / 24.0
-        a = theta * f
-        if a < 1e-9:
-            c = (X0 + LENGTH * f, Y0, 0.0)
-        else:
-            r = LENGTH * f / a
-            c = (X0 + r * math.sin(a), Y0 + r * (1.0 - math.cos(a)), 0.0)
-        q = qmul(qaxis((0.0, 0.0, 1.0), a), qaxis((1.0, 0.0, 0.0), TWIST * s * f))
+        centre, q = section(s, i / 24.0)
         for side in (-1.0, 1.0):
-            e = qrot(q, (0.0, 0.0, side * WIDTH / 2.0))
-            points.append((c[0] + e[0], c[1] + e[1], c[2] + e[2]))
+            points.append(on_section(centre, q, (0.0, 0.0, side * WIDTH / 2.0)))
     return points
 
 
@@ -189,26 +192,12 @@ def camera_track(times):
     return positions, rotations
 
 
-def tracks():
-    return handle_tracks(CORNERS, corner_pose, T_END, KEYS_PER_SECOND)
-
-
-def check(times, tracks_):
-    """No two held points ever get farther apart than on the pattern."""
-    pattern = {name: (u, v) for name, u, v in CORNERS}
-    return check_no_stretch(times, tracks_, pattern, (LENGTH, WIDTH),
-                            ((1.0, 0.0, 0.0), (0.0, 0.0, -1.0)))
-
-
 def main():
-    here = os.path.dirname(os.path.abspath(__file__))
-    path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "moebius.gltf")
-    times, tr = tracks()
-    check(times, tr)
-    cam_positions, cam_rotations = camera_track(times)
-    write_gltf(path, "crumple samples/moebius/make_moebius_gltf.py", times,
-               tr + [(CAMERA, cam_positions, cam_rotations)],
-               camera=(CAMERA, CAMERA_YFOV, CAMERA_ASPECT))
+    times, tracks = handle_tracks(CORNERS, corner_pose, T_END)
+    # No two held points ever get farther apart than on the pattern.
+    check_no_stretch(times, tracks, CORNERS, (LENGTH, WIDTH), ((1.0, 0.0, 0.0), (0.0, 0.0, -1.0)))
+    write_sample(__file__, "moebius.gltf", times, tracks + [(CAMERA, *camera_track(times))],
+                 camera=(CAMERA, CAMERA_YFOV, CAMERA_ASPECT))
 
 
 if __name__ == "__main__":

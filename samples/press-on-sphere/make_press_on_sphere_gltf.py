@@ -51,6 +51,11 @@ import math
 import os
 import sys
 
+# Shared helpers (samples/gltf_anim.py).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from gltf_anim import (add_sphere_meshes, check_no_stretch, cross, handle_tracks, qaxis,  # noqa: E402
+                       ramp, write_sample)
+
 # ---- geometry and timing (metres, seconds, radians) ----
 W = 0.15              # sheet side (u and v)
 R = 0.04              # ball radius
@@ -61,7 +66,6 @@ ALPHA_END = math.radians(60.0)
 BALL_INSET = 0.0005   # the ball is drawn this much smaller than the collider
 T_PRESS = (0.25, 1.75)
 T_END = 3.0
-KEYS_PER_SECOND = 48
 SPHERE_SEGMENTS = (48, 24)  # longitude x latitude of the ball's render mesh
 
 # (node name, u, v) in metres on the pattern
@@ -69,12 +73,6 @@ CORNERS = [("CornerSW", 0.0, 0.0), ("CornerSE", W, 0.0),
            ("CornerNW", 0.0, W), ("CornerNE", W, W)]
 U_AXIS = (1.0, 0.0, 0.0)
 V_AXIS = (0.0, 0.0, -1.0)
-
-
-# Shared helpers (samples/gltf_anim.py).
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from gltf_anim import (add_sphere_meshes, check_no_stretch, cross, handle_tracks, qaxis,  # noqa: E402
-                       ramp, write_gltf)
 
 
 # ---- the motion ----
@@ -103,25 +101,18 @@ def corner_pose(u, v, t):
     return (C[0] + r * d[0], y, C[2] + r * d[2]), qaxis(axis, alpha)
 
 
-def tracks():
-    return handle_tracks(CORNERS, corner_pose, T_END, KEYS_PER_SECOND)
-
-
-def check(times, tracks_):
+def check(times, tracks):
     """No two held points ever get farther apart than on the pattern, and the
     corners stay above the table."""
-    pattern = {name: (u, v) for name, u, v in CORNERS}
-    lowest = min(p[1] for _, positions, _ in tracks_ for p in positions)
+    lowest = min(p[1] for _, positions, _ in tracks for p in positions)
     assert lowest > 0.005, "a corner comes within %.1f mm of the table" % (1000 * lowest)
-    return check_no_stretch(times, tracks_, pattern, (W, W), (U_AXIS, V_AXIS))
+    return check_no_stretch(times, tracks, CORNERS, (W, W), (U_AXIS, V_AXIS))
 
 
 def main():
-    here = os.path.dirname(os.path.abspath(__file__))
-    path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "press-on-sphere.gltf")
-    times, tr = tracks()
-    check(times, tr)
-    write_gltf(path, "crumple samples/press-on-sphere/make_press_on_sphere_gltf.py", times, tr)
+    times, tracks = handle_tracks(CORNERS, corner_pose, T_END)
+    check(times, tracks)
+    path = write_sample(__file__, "press-on-sphere.gltf", times, tracks)
     add_sphere_meshes(path, [("Ball", R - BALL_INSET, C)], SPHERE_SEGMENTS)
 
 

@@ -60,6 +60,10 @@ import math
 import os
 import sys
 
+# Shared helpers (samples/gltf_anim.py).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from gltf_anim import handle_tracks, qaxis, qrot, ramp, write_sample  # noqa: E402
+
 # ---- geometry and timing (metres, seconds, radians) ----
 W = 0.21              # sheet width (u, world X)
 H = 0.148             # sheet depth (v, world -Z)
@@ -72,17 +76,11 @@ T_SLIDE = (0.30, 1.60)
 T_RELEASE = 2.00      # the scene's release_time of the back handles
 T_PINCH = (2.00, 2.50)
 T_END = 3.50
-KEYS_PER_SECOND = 48
 
 # (node name, u, v) in metres on the pattern
 FRONT = [("FrontL", 0.0, 0.0), ("FrontM", W / 2.0, 0.0), ("FrontR", W, 0.0),
          ("Grip", W / 2.0, GRIP)]
 BACK = [("BackL", 0.0, H), ("BackM", W / 2.0, H), ("BackR", W, H)]
-
-
-# Shared helpers (samples/gltf_anim.py).
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from gltf_anim import handle_tracks, qaxis, qrot, ramp, write_gltf  # noqa: E402
 
 
 def arc(psi):
@@ -136,7 +134,7 @@ def pose(u, v, t):
 
 
 def tracks():
-    times, tr = handle_tracks(FRONT + BACK, pose, T_END, KEYS_PER_SECOND)
+    times, tr = handle_tracks(FRONT + BACK, pose, T_END)
     return times, [(name, positions, None) for name, positions, _ in tr]  # positions only
 
 
@@ -163,11 +161,9 @@ def check(times, tracks_):
 
 
 def main():
-    here = os.path.dirname(os.path.abspath(__file__))
-    path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "slide-on-table.gltf")
     times, tr = tracks()
     check(times, tr)
-    write_gltf(path, "crumple samples/slide-on-table/make_slide_on_table_gltf.py", times, tr)
+    write_sample(__file__, "slide-on-table.gltf", times, tr)
 
 
 if __name__ == "__main__":

@@ -29,7 +29,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from gltf_anim import handle_tracks, qaxis, ramp, write_gltf  # noqa: E402
+from gltf_anim import handle_tracks, qaxis, ramp, write_sample  # noqa: E402
 
 W = 0.10
 L = 0.10
@@ -55,10 +55,7 @@ def pose(u, v, t):
 
 
 def main():
-    here = os.path.dirname(os.path.abspath(__file__))
-    times, tracks = handle_tracks(FINGERS, pose, T_END, 48)
-    write_gltf(sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "tear-cylinder.gltf"),
-               "crumple samples/tear-cylinder/make_tear_cylinder_gltf.py", times, tracks)
+    write_sample(__file__, "tear-cylinder.gltf", *handle_tracks(FINGERS, pose, T_END))
 
 
 if __name__ == "__main__":

@@ -42,6 +42,10 @@ import math
 import os
 import sys
 
+# Shared helpers (samples/gltf_anim.py).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from gltf_anim import check_no_stretch, handle_tracks, qaxis, smoother, write_sample  # noqa: E402
+
 # ---- geometry and timing (metres, seconds, radians) ----
 W = 0.148                   # sheet width (u, world X)
 H = 0.21                    # sheet height (v, world Y)
@@ -59,11 +63,6 @@ KEYS_PER_SECOND = 96
 CORNERS = [("TopL", 0.0, H), ("TopR", W, H)]
 
 
-# Shared helpers (samples/gltf_anim.py).
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from gltf_anim import check_no_stretch, handle_tracks, qaxis, smoother, write_gltf  # noqa: E402
-
-
 def envelope(t):
     a, b = T_SHAKE
     return smoother((t - a) / RAMP) * smoother((b - t) / RAMP)
@@ -79,12 +78,9 @@ def pose(u, v, t):
 
 
 def main():
-    here = os.path.dirname(os.path.abspath(__file__))
-    path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "wiggle.gltf")
     times, tracks = handle_tracks(CORNERS, pose, T_END, KEYS_PER_SECOND)
-    check_no_stretch(times, tracks, {name: (u, v) for name, u, v in CORNERS}, (W, H),
-                     ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0)))
-    write_gltf(path, "crumple samples/wiggle/make_wiggle_gltf.py", times, tracks)
+    check_no_stretch(times, tracks, CORNERS, (W, H), ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0)))
+    write_sample(__file__, "wiggle.gltf", times, tracks)
 
 
 if __name__ == "__main__":

@@ -19,7 +19,8 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "..", "samples"))
-from gltf_anim import check_no_stretch, qaxis, ramp, write_gltf  # noqa: E402
+from gltf_anim import (check_no_stretch, handle_tracks, key_times, qaxis, ramp,  # noqa: E402
+                       write_gltf)
 
 SEED = 9  # random-10000's motion
 GENERATOR = "crumple tests/stability/scenes/make_scenes.py"
@@ -43,13 +44,19 @@ def scene_toml(header, name, units, frames, substeps, sheet, handles, paper="off
     return "\n".join(lines) + "\n" + extra
 
 
+def sheet_table(width, height, max_edge, origin, v_axis=(0.0, 1.0, 0.0)):
+    """The [sheet] table's keys for scene_toml, in the scene's units (pass
+    floats: they are written as Python prints them): pattern u along world
+    +X, v along v_axis (by default +Y: a sheet in the XY plane)."""
+    def vec(v):
+        return "[%s]" % ", ".join(repr(c) for c in v)
+    return [("width", repr(width)), ("height", repr(height)), ("max_edge", repr(max_edge)),
+            ("origin", vec(origin)), ("u_axis", vec((1.0, 0.0, 0.0))), ("v_axis", vec(v_axis))]
+
+
 def sample(times, funcs):
     """[(node, [position at t])] from {node: t -> position}."""
     return [(name, [f(t) for t in times], None) for name, f in funcs]
-
-
-def keys(t_end, per_second):
-    return [k / per_second for k in range(int(round(t_end * per_second)) + 1)]
 
 
 def lerp(a, b, s):
@@ -66,9 +73,7 @@ def write(case, toml, times, tracks):
 
 # A 10 x 10 cm sheet hanging in the XY plane from its top corners (v = 10 cm
 # at y = 20 cm, x = -5 .. 5 cm): the frame of most cases.
-HANG_SHEET = [("width", "10.0"), ("height", "10.0"), ("max_edge", "1.0"),
-              ("origin", "[-5.0, 10.0, 0.0]"), ("u_axis", "[1.0, 0.0, 0.0]"),
-              ("v_axis", "[0.0, 1.0, 0.0]")]
+HANG_SHEET = sheet_table(10.0, 10.0, 1.0, (-5.0, 10.0, 0.0))
 HANG_HANDLES = [("A", 0.0, 10.0), ("B", 10.0, 10.0)]
 A0 = (-0.05, 0.20, 0.0)
 B0 = (0.05, 0.20, 0.0)
@@ -99,9 +104,7 @@ def case_compress():
     side slides over 0.25-1.5 s towards the left one until they are 1 cm apart
     (10 % of the width), holds to 2 s, comes back to 9 cm by 2.75 s and holds
     to 3 s. The sheet buckles down under gravity into a deep U."""
-    sheet = [("width", "10.0"), ("height", "10.0"), ("max_edge", "1.0"),
-             ("origin", "[-5.0, 10.0, 5.0]"), ("u_axis", "[1.0, 0.0, 0.0]"),
-             ("v_axis", "[0.0, 0.0, -1.0]")]
+    sheet = sheet_table(10.0, 10.0, 1.0, (-5.0, 10.0, 5.0), v_axis=(0.0, 0.0, -1.0))
     handles = [("L%d" % i, 0.0, v) for i, v in enumerate((0.0, 5.0, 10.0))] + \
               [("R%d" % i, 10.0, v) for i, v in enumerate((0.0, 5.0, 10.0))]
 
@@ -110,7 +113,7 @@ def case_compress():
         x = -0.05 if name[0] == "L" else 0.05 - 0.09 * s
         return (x, 0.10, 0.05 - v * 0.01)
 
-    times = keys(3.0, 48)
+    times = key_times(3.0)
     tracks = [(n, [pos(n, v, t) for t in times], None) for n, _, v in handles]
     toml = scene_toml(case_compress.__doc__, "compress-10", "cm", (0, 72), 4, sheet, handles)
     write("compress-10", toml, times, tracks)
@@ -124,9 +127,7 @@ def case_twist():
     by 4 pi over 14 cm are helices of about 24 cm: the paper's length),
     holds to 2.75 s, untwists back by 4.75 s and holds to 5 s."""
     length, width = 0.24, 0.03
-    sheet = [("width", "24.0"), ("height", "3.0"), ("max_edge", "1.0"),
-             ("origin", "[-12.0, 10.0, 1.5]"), ("u_axis", "[1.0, 0.0, 0.0]"),
-             ("v_axis", "[0.0, 0.0, -1.0]")]
+    sheet = sheet_table(24.0, 3.0, 1.0, (-12.0, 10.0, 1.5), v_axis=(0.0, 0.0, -1.0))
     handles = [("EndA0", 0.0, 0.0, True), ("EndA1", 0.0, 3.0, True),
                ("EndB0", 24.0, 0.0, True), ("EndB1", 24.0, 3.0, True)]
 
@@ -142,13 +143,9 @@ def case_twist():
         x = length / 2.0 - 0.10 * s
         return (x, 0.10 + offset[1], offset[2]), qaxis((1.0, 0.0, 0.0), angle)
 
-    times = keys(5.0, 48)
-    tracks = []
-    for name, u, v, _ in handles:
-        poses = [pose(u * 0.01, v * 0.01, t) for t in times]
-        tracks.append((name, [p for p, _ in poses], [q for _, q in poses]))
-    check_no_stretch(times, tracks, {n: (u * 0.01, v * 0.01) for n, u, v, _ in handles},
-                     (length, width), ((1.0, 0.0, 0.0), (0.0, 0.0, -1.0)))
+    pattern = [(name, u * 0.01, v * 0.01) for name, u, v, _ in handles]  # metres
+    times, tracks = handle_tracks(pattern, pose, 5.0)
+    check_no_stretch(times, tracks, pattern, (length, width), ((1.0, 0.0, 0.0), (0.0, 0.0, -1.0)))
     toml = scene_toml(case_twist.__doc__, "twist-4pi", "cm", (0, 120), 4, sheet, handles)
     write("twist-4pi", toml, times, tracks)
 
@@ -184,7 +181,7 @@ def case_same_point():
     def at(p0):
         return lambda t: lerp(p0, target, ramp(t, (0.25, 1.0)) - ramp(t, (1.5, 2.25)))
 
-    times = keys(2.5, 48)
+    times = key_times(2.5)
     tracks = sample(times, [("A", at(A0)), ("B", at(B0))])
     hang_check(times, tracks)
     toml = scene_toml(case_same_point.__doc__, "same-point", "cm", (0, 60), 4, HANG_SHEET,
@@ -198,7 +195,7 @@ def case_beyond_reach():
     the sheet's reach: no paper can follow), stays there to 1.5 s, comes back
     to its start by 2.25 s and holds to 2.5 s."""
     far = (0.35, 0.20, 0.0)
-    times = keys(2.5, 48)
+    times = key_times(2.5)
     tracks = sample(times, [("A", lambda t: A0),
                             ("B", lambda t: lerp(B0, far, ramp(t, (0.25, 1.0)) -
                                                  ramp(t, (1.5, 2.25))))])
@@ -209,7 +206,7 @@ def case_beyond_reach():
 
 def swing_case(case, doc, sheet, handles, a0, b0, gap, lift, units, scale, paper, frames,
                size, substeps=4):
-    times = keys(2.25, 48)
+    times = key_times(2.25)
     tracks = [(handles[0][0], [swing(a0, b0, gap, lift, t)[0] for t in times], None),
               (handles[1][0], [swing(a0, b0, gap, lift, t)[1] for t in times], None)]
     hang_check(times, tracks, size=size, handles=handles, scale=scale)
@@ -241,10 +238,8 @@ def case_tiny():
     """tiny-1cm: a 1 x 1 cm sheet (units mm, 1 mm mesh) hanging from its top
     corners, which swing together to 2 mm apart and 4 mm towards the camera
     over 0.25-1.0 s and back apart by 2.0 s; hold to 2.25 s."""
-    sheet = [("width", "10.0"), ("height", "10.0"), ("max_edge", "1.0"),
-             ("origin", "[-5.0, 10.0, 0.0]"), ("u_axis", "[1.0, 0.0, 0.0]"),
-             ("v_axis", "[0.0, 1.0, 0.0]")]
-    swing_case("tiny-1cm", case_tiny.__doc__, sheet, HANG_HANDLES, (-0.005, 0.02, 0.0),
+    # The hanging sheet's table, read in millimetres.
+    swing_case("tiny-1cm", case_tiny.__doc__, HANG_SHEET, HANG_HANDLES, (-0.005, 0.02, 0.0),
                (0.005, 0.02, 0.0), 0.002, 0.004, "mm", 0.001, "office-70gsm", (0, 54),
                (0.01, 0.01))
 
@@ -253,9 +248,7 @@ def case_poster():
     """poster-1m: a 100 x 70 cm poster (5 cm mesh) hanging from its top
     corners, which swing together to 20 cm apart and 40 cm towards the camera
     over 0.25-1.0 s and back apart by 2.0 s; hold to 2.25 s."""
-    sheet = [("width", "100.0"), ("height", "70.0"), ("max_edge", "5.0"),
-             ("origin", "[-50.0, 30.0, 0.0]"), ("u_axis", "[1.0, 0.0, 0.0]"),
-             ("v_axis", "[0.0, 1.0, 0.0]")]
+    sheet = sheet_table(100.0, 70.0, 5.0, (-50.0, 30.0, 0.0))
     handles = [("A", 0.0, 70.0), ("B", 100.0, 70.0)]
     swing_case("poster-1m", case_poster.__doc__, sheet, handles, (-0.5, 1.0, 0.0),
                (0.5, 1.0, 0.0), 0.2, 0.4, "cm", 0.01, "office-70gsm", (0, 54), (1.0, 0.7))
@@ -268,9 +261,7 @@ def case_random():
     key, a step of up to 3 cm in each axis, kept in a 30 cm box and kept
     within 95 % of the sheet's reach of the other handles (no handle pair is
     ever farther apart than on the pattern)."""
-    sheet = [("width", "10.0"), ("height", "10.0"), ("max_edge", "1.25"),
-             ("origin", "[-5.0, 10.0, 0.0]"), ("u_axis", "[1.0, 0.0, 0.0]"),
-             ("v_axis", "[0.0, 1.0, 0.0]")]
+    sheet = sheet_table(10.0, 10.0, 1.25, (-5.0, 10.0, 0.0))
     handles = HANG_HANDLES + [("C", 5.0, 0.0)]
     rest = {"A": A0, "B": B0, "C": (0.0, 0.10, 0.0)}
     reach = {}
@@ -279,7 +270,7 @@ def case_random():
             reach[(n, m)] = reach[(m, n)] = 0.95 * math.hypot(u - u2, v - v2) * 0.01
     rng = random.Random(SEED)
     t_end = 10001 / 24.0
-    times = keys(math.ceil(t_end * 4) / 4.0, 4)
+    times = key_times(math.ceil(t_end * 4) / 4.0, 4)
     pos = [dict(rest)]
     # First key at rest (the handles start on their sheet points), then
     # every key a random step that keeps every pair within reach.
