@@ -37,7 +37,8 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const auto parsed = bench::parseShotBenchArgs(argc, argv, "bench_contacts", {"slide-on-table", "press-on-sphere", "fold-over"});
+  const auto parsed = bench::parseShotBenchArgs(argc, argv, "bench_contacts",
+                                                {"slide-on-table", "press-on-sphere", "fold-over"});
   if (!parsed) return 0;
   const bench::ShotBenchArgs& args = *parsed;
   const int runs = args.runs;
@@ -80,12 +81,12 @@ int main(int argc, char** argv) {
   std::error_code ignored;
   fs::remove_all(scratch, ignored);
   const auto toJson = [](const Row& r) {
-    return bench::format("{\"sample\": \"%s\", \"frames\": %d, \"step_ms_per_frame\": %.6g, "
-                  "\"collider_ms_per_frame\": %.6g, \"self_contact_ms_per_frame\": %.6g, "
-                  "\"share_of_step\": %.6g, \"depth_check_ms_per_frame\": %.6g, "
-                  "\"max_depth_thicknesses\": %.6g}",
-                  r.sample.c_str(), r.frames, r.stepMs, r.colliderMs, r.selfMs, r.share,
-                  r.checkMs, r.depth);
+    return bench::format(
+        "{\"sample\": \"%s\", \"frames\": %d, \"step_ms_per_frame\": %.6g, "
+        "\"collider_ms_per_frame\": %.6g, \"self_contact_ms_per_frame\": %.6g, "
+        "\"share_of_step\": %.6g, \"depth_check_ms_per_frame\": %.6g, "
+        "\"max_depth_thicknesses\": %.6g}",
+        r.sample.c_str(), r.frames, r.stepMs, r.colliderMs, r.selfMs, r.share, r.checkMs, r.depth);
   };
   if (!bench::writeSampleRows(args, "bench_contacts", rows, toJson)) return 1;
   return 0;

@@ -39,7 +39,8 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const auto parsed = bench::parseShotBenchArgs(argc, argv, "bench_sound", {"wiggle", "slide-on-table", "crumple", "tear-fast"});
+  const auto parsed = bench::parseShotBenchArgs(
+      argc, argv, "bench_sound", {"wiggle", "slide-on-table", "crumple", "tear-fast"});
   if (!parsed) return 0;
   const bench::ShotBenchArgs& args = *parsed;
   const std::vector<std::string>& samples = args.samples;
@@ -92,12 +93,13 @@ int main(int argc, char** argv) {
   std::error_code ignored;
   fs::remove_all(scratch, ignored);
   const auto toJson = [](const Row& r) {
-    return bench::format("{\"sample\": \"%s\", \"frames\": %d, \"events\": %ld, "
-                  "\"step_ms_per_frame\": %.6g, \"events_ms_per_frame\": %.6g, "
-                  "\"resonator_ms_per_frame\": %.6g, \"seconds\": %.6g, \"synthesis_ms\": %.6g, "
-                  "\"x_real_time\": %.6g}",
-                  r.sample.c_str(), r.frames, r.events, r.stepMs, r.eventsMs, r.resonatorMs,
-                  r.seconds, r.synthesisMs, r.realTime);
+    return bench::format(
+        "{\"sample\": \"%s\", \"frames\": %d, \"events\": %ld, "
+        "\"step_ms_per_frame\": %.6g, \"events_ms_per_frame\": %.6g, "
+        "\"resonator_ms_per_frame\": %.6g, \"seconds\": %.6g, \"synthesis_ms\": %.6g, "
+        "\"x_real_time\": %.6g}",
+        r.sample.c_str(), r.frames, r.events, r.stepMs, r.eventsMs, r.resonatorMs, r.seconds,
+        r.synthesisMs, r.realTime);
   };
   if (!bench::writeSampleRows(args, "bench_sound", rows, toJson)) return 1;
   return 0;

@@ -36,7 +36,8 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const auto parsed = bench::parseShotBenchArgs(argc, argv, "bench_tear", {"tear-straight", "tear-curved", "tear-notch"});
+  const auto parsed = bench::parseShotBenchArgs(argc, argv, "bench_tear",
+                                                {"tear-straight", "tear-curved", "tear-notch"});
   if (!parsed) return 0;
   const bench::ShotBenchArgs& args = *parsed;
   const int runs = args.runs;
@@ -75,10 +76,11 @@ int main(int argc, char** argv) {
   std::error_code ignored;
   fs::remove_all(scratch, ignored);
   const auto toJson = [](const Row& r) {
-    return bench::format("{\"sample\": \"%s\", \"frames\": %d, \"tip_advances\": %zu, "
-                  "\"step_ms_per_frame\": %.6g, \"tear_ms_per_frame\": %.6g, "
-                  "\"bake_ms_per_frame\": %.6g, \"share_of_step\": %.6g}",
-                  r.sample.c_str(), r.frames, r.advances, r.stepMs, r.tearMs, r.bakeMs, r.share);
+    return bench::format(
+        "{\"sample\": \"%s\", \"frames\": %d, \"tip_advances\": %zu, "
+        "\"step_ms_per_frame\": %.6g, \"tear_ms_per_frame\": %.6g, "
+        "\"bake_ms_per_frame\": %.6g, \"share_of_step\": %.6g}",
+        r.sample.c_str(), r.frames, r.advances, r.stepMs, r.tearMs, r.bakeMs, r.share);
   };
   if (!bench::writeSampleRows(args, "bench_tear", rows, toJson)) return 1;
   return 0;

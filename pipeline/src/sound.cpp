@@ -28,7 +28,7 @@ namespace {
 constexpr double kPeakDbfs = -1.0;  // the normalised mix's peak
 
 const char* kindName(sound::EventKind kind) {
-  return kind == sound::EventKind::Crumpling ? "crumpling"
+  return kind == sound::EventKind::Crumpling  ? "crumpling"
          : kind == sound::EventKind::Friction ? "friction"
                                               : "tearing";
 }
@@ -77,7 +77,7 @@ std::string soundPath(const std::string& cachePath, const std::string& out) {
 
 // A frame's SEVT block, its errors naming the cache and the frame.
 std::optional<std::vector<sound::SoundEvent>> frameEvents(const std::string& cachePath,
-                                                                const cache::FrameRecord& record) {
+                                                          const cache::FrameRecord& record) {
   try {
     return cache::decodeSoundEvents(record.extensions);
   } catch (const CorruptDataError& e) {
@@ -214,8 +214,10 @@ std::string eventTimeline(const std::string& cachePath) {
                     e.position.z());
       out << line;
       for (const auto& q : e.resonators) {
-        std::snprintf(line, sizeof line, " %.1f %.1f %.0f%s", 100.0 * q.ruling, 100.0 * q.border,
-                      1e4 * q.area, e.kind == sound::EventKind::Crumpling ? (q.border > 0.0 ? " flap" : " clac") : "");
+        std::snprintf(
+            line, sizeof line, " %.1f %.1f %.0f%s", 100.0 * q.ruling, 100.0 * q.border,
+            1e4 * q.area,
+            e.kind == sound::EventKind::Crumpling ? (q.border > 0.0 ? " flap" : " clac") : "");
         out << line << ";";
       }
       out << "\n";

@@ -45,8 +45,8 @@ CachedEvents readEvents(const std::string& cachePath) {
   for (std::size_t i = 0; i < reader.frameCount(); ++i) {
     const auto frame = reader.readFrame(i);
     out.frames.push_back(frame.frame);
-    out.events.push_back(cache::decodeSoundEvents(frame.extensions)
-                             .value_or(std::vector<sound::SoundEvent>{}));
+    out.events.push_back(
+        cache::decodeSoundEvents(frame.extensions).value_or(std::vector<sound::SoundEvent>{}));
   }
   return out;
 }

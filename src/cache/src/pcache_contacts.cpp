@@ -22,7 +22,6 @@ static_assert(std::numeric_limits<double>::is_iec559 && sizeof(double) == 8,
               "doubles are stored as IEEE-754 binary64");
 static_assert(sizeof(int) == 4, "ints are stored as 32-bit two's complement");
 
-
 // Smallest encoded record: a collider with two empty strings (2 u32 + f64),
 // a contact (2 i32 + 2 f32).
 constexpr std::size_t kMinColliderBytes = 4 + 4 + 8;

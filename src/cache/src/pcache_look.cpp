@@ -8,8 +8,8 @@
 
 namespace crumple::cache {
 
-using detail::findOneBlock;
 using detail::decodeBlock;
+using detail::findOneBlock;
 using detail::readRecords;
 using detail::SubBlockReader;
 using detail::writeRecords;

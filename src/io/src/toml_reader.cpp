@@ -13,10 +13,14 @@ namespace crumple::io::detail {
 
 const char* typeName(const toml::node& n) {
   static constexpr std::pair<toml::node_type, const char*> kNames[] = {
-      {toml::node_type::table, "a table"},       {toml::node_type::array, "an array"},
-      {toml::node_type::string, "a string"},     {toml::node_type::integer, "an integer"},
-      {toml::node_type::floating_point, "a float"}, {toml::node_type::boolean, "a boolean"},
-      {toml::node_type::date, "a date"},         {toml::node_type::time, "a time"},
+      {toml::node_type::table, "a table"},
+      {toml::node_type::array, "an array"},
+      {toml::node_type::string, "a string"},
+      {toml::node_type::integer, "an integer"},
+      {toml::node_type::floating_point, "a float"},
+      {toml::node_type::boolean, "a boolean"},
+      {toml::node_type::date, "a date"},
+      {toml::node_type::time, "a time"},
       {toml::node_type::date_time, "a date-time"}};
   for (const auto& [type, name] : kNames)
     if (n.type() == type) return name;

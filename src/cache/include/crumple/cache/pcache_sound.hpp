@@ -39,7 +39,7 @@ struct SoundSetupRecord {
 // Throw std::invalid_argument for a value the decoder would reject: a kind
 // above 2, a non-finite value, a negative amplitude, size or radius, or a
 // tear below -1, a negative duration; std::length_error for more than 2^32 - 1 records.
-ExtensionBlock encodeSoundSetup(const SoundSetupRecord& setup);                 // tag "SNDS"
+ExtensionBlock encodeSoundSetup(const SoundSetupRecord& setup);                  // tag "SNDS"
 ExtensionBlock encodeSoundEvents(const std::vector<sound::SoundEvent>& events);  // tag "SEVT"
 
 // nullopt when no block carries the tag (a cache made without [sound]; a
