@@ -41,18 +41,16 @@ int main(int argc, char** argv) {
                                                 {"slide-on-table", "press-on-sphere", "fold-over"});
   if (!parsed) return 0;
   const bench::ShotBenchArgs& args = *parsed;
-  const int runs = args.runs;
-  const std::vector<std::string>& samples = args.samples;
   setThreadCount(1);
-  const fs::path scratch = fs::temp_directory_path() / "crumple-bench-contacts";
+  const bench::ScratchDir scratch("crumple-bench-contacts");
   std::vector<Row> rows;
-  for (const std::string& name : samples) {
+  for (const std::string& name : args.samples) {
     const io::SceneSpec scene = bench::sampleScene(name);
     std::vector<double> step, collider, self, share, check;
     Row row;
     row.sample = name;
-    for (int r = 0; r < runs; ++r) {
-      const pipeline::ShotReport report = bench::simulateQuietly(scene, (scratch / name).string());
+    for (int r = 0; r < args.runs; ++r) {
+      const pipeline::ShotReport report = bench::simulateQuietly(scene, scratch / name);
       const double frames = std::max(1, report.framesSimulated - 1);
       const double stepTotal = bench::stepTotalMs(report);
       step.push_back(stepTotal / frames);
@@ -78,8 +76,6 @@ int main(int argc, char** argv) {
         100.0 * row.share, row.checkMs, row.depth);
     std::fflush(stdout);
   }
-  std::error_code ignored;
-  fs::remove_all(scratch, ignored);
   const auto toJson = [](const Row& r) {
     return bench::format(
         "{\"sample\": \"%s\", \"frames\": %d, \"step_ms_per_frame\": %.6g, "

@@ -43,11 +43,10 @@ int main(int argc, char** argv) {
       argc, argv, "bench_sound", {"wiggle", "slide-on-table", "crumple", "tear-fast"});
   if (!parsed) return 0;
   const bench::ShotBenchArgs& args = *parsed;
-  const std::vector<std::string>& samples = args.samples;
   setThreadCount(1);
-  const fs::path scratch = fs::temp_directory_path() / "crumple-bench-sound";
+  const bench::ScratchDir scratch("crumple-bench-sound");
   std::vector<Row> rows;
-  for (const std::string& name : samples) {
+  for (const std::string& name : args.samples) {
     const io::SceneSpec scene = bench::sampleScene(name);
     if (!scene.soundEnabled) {
       std::fprintf(stderr, "bench_sound: %s has no [sound] table\n", name.c_str());
@@ -58,7 +57,7 @@ int main(int argc, char** argv) {
     std::vector<double> step, events, resonators, synthesis;
     std::string cachePath;
     for (int r = 0; r < args.runs; ++r) {
-      const pipeline::ShotReport report = bench::simulateQuietly(scene, (scratch / name).string());
+      const pipeline::ShotReport report = bench::simulateQuietly(scene, scratch / name);
       const double frames = std::max(1, report.framesSimulated);
       step.push_back(bench::stepTotalMs(report) / frames);
       events.push_back(report.stages.at("sound events").totalMs / frames);
@@ -69,7 +68,7 @@ int main(int argc, char** argv) {
     }
     for (int r = 0; r < args.runs; ++r) {
       pipeline::SoundOptions options;
-      options.out = (scratch / name / "bench.wav").string();
+      options.out = (scratch.path() / name / "bench.wav").string();
       options.spectrogram = false;
       options.log = nullptr;
       options.interactive = 0;
@@ -90,8 +89,6 @@ int main(int argc, char** argv) {
         row.synthesisMs, row.seconds, row.realTime);
     std::fflush(stdout);
   }
-  std::error_code ignored;
-  fs::remove_all(scratch, ignored);
   const auto toJson = [](const Row& r) {
     return bench::format(
         "{\"sample\": \"%s\", \"frames\": %d, \"events\": %ld, "

@@ -40,18 +40,16 @@ int main(int argc, char** argv) {
                                                 {"tear-straight", "tear-curved", "tear-notch"});
   if (!parsed) return 0;
   const bench::ShotBenchArgs& args = *parsed;
-  const int runs = args.runs;
-  const std::vector<std::string>& samples = args.samples;
   setThreadCount(1);
-  const fs::path scratch = fs::temp_directory_path() / "crumple-bench-tear";
+  const bench::ScratchDir scratch("crumple-bench-tear");
   std::vector<Row> rows;
-  for (const std::string& name : samples) {
+  for (const std::string& name : args.samples) {
     const io::SceneSpec scene = bench::sampleScene(name);
     std::vector<double> step, tear, bake, share;
     Row row;
     row.sample = name;
-    for (int r = 0; r < runs; ++r) {
-      const pipeline::ShotReport report = bench::simulateQuietly(scene, (scratch / name).string());
+    for (int r = 0; r < args.runs; ++r) {
+      const pipeline::ShotReport report = bench::simulateQuietly(scene, scratch / name);
       const double frames = std::max(1, report.framesSimulated - 1);
       const double stepTotal = bench::stepTotalMs(report);
       step.push_back(stepTotal / frames);
@@ -73,8 +71,6 @@ int main(int argc, char** argv) {
         100.0 * row.share);
     std::fflush(stdout);
   }
-  std::error_code ignored;
-  fs::remove_all(scratch, ignored);
   const auto toJson = [](const Row& r) {
     return bench::format(
         "{\"sample\": \"%s\", \"frames\": %d, \"tip_advances\": %zu, "

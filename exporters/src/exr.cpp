@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "crumple/core/error.hpp"
-#include "image_checks.hpp"
+#include "image_write.hpp"
 
 namespace crumple::exporters {
 namespace {
@@ -107,13 +107,7 @@ void writeExr(const std::string& path, const ImageRGBAF& image) {
   std::string problem;
   if (std::fwrite(bytes.data(), 1, bytes.size(), file.get()) != bytes.size())
     problem = std::strerror(errno);
-  if (std::fclose(file.release()) != 0 && problem.empty()) problem = std::strerror(errno);
-  if (problem.empty() && std::rename(tmp.c_str(), path.c_str()) != 0)
-    problem = std::string("cannot rename the temporary file: ") + std::strerror(errno);
-  if (!problem.empty()) {
-    std::remove(tmp.c_str());
-    throw InputError(path, "cannot write EXR: " + problem);
-  }
+  finishAtomicWrite(file.release(), tmp, path, "EXR", problem);
 }
 
 // EXR read through a float FrameBuffer over the data window.

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "crumple/core/error.hpp"
-#include "image_checks.hpp"
+#include "image_write.hpp"
 
 namespace crumple::exporters {
 namespace {
@@ -149,13 +149,7 @@ void writePng(const std::string& path, const ImageRGBA8& image) {
       problem = describe(state);
     }
   }
-  if (std::fclose(file.release()) != 0 && problem.empty()) problem = std::strerror(errno);
-  if (problem.empty() && std::rename(tmp.c_str(), path.c_str()) != 0)
-    problem = std::string("cannot rename the temporary file: ") + std::strerror(errno);
-  if (!problem.empty()) {
-    std::remove(tmp.c_str());
-    throw InputError(path, "cannot write PNG: " + problem);
-  }
+  finishAtomicWrite(file.release(), tmp, path, "PNG", problem);
 }
 
 namespace {

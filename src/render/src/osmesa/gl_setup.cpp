@@ -38,6 +38,14 @@ void floatAttribute(GLuint index, GLint components, std::size_t offset) {
                         reinterpret_cast<const void*>(offset));
 }
 
+// A new vertex array and its buffer, both bound.
+void bindNewVertexArray(GLuint& vao, GLuint& vbo) {
+  glGenVertexArrays(1, &vao);
+  glGenBuffers(1, &vbo);
+  glBindVertexArray(vao);
+  glBindBuffer(GL_ARRAY_BUFFER, vbo);
+}
+
 // The attribute layout of a Vertex buffer (position, normal, uv) on the bound array.
 void setupVertexLayout() {
   floatAttribute<Vertex>(0, 3, offsetof(Vertex, pos));
@@ -107,50 +115,18 @@ GLuint OsmesaRenderer::Impl::mainProgram(int numLights, int keyLight, bool keyIs
 }
 
 void OsmesaRenderer::Impl::createGeometry() {
-  glGenVertexArrays(1, &paperVao);
-  glGenBuffers(1, &paperVbo);
-  glBindVertexArray(paperVao);
-  glBindBuffer(GL_ARRAY_BUFFER, paperVbo);
+  bindNewVertexArray(paperVao, paperVbo);
   setupVertexLayout();
-
-  glGenVertexArrays(1, &groundVao);
-  glGenBuffers(1, &groundVbo);
-  glBindVertexArray(groundVao);
-  glBindBuffer(GL_ARRAY_BUFFER, groundVbo);
+  bindNewVertexArray(groundVao, groundVbo);
   setupVertexLayout();
-
-  glGenVertexArrays(1, &propVao);
-  glGenBuffers(1, &propVbo);
-  glBindVertexArray(propVao);
-  glBindBuffer(GL_ARRAY_BUFFER, propVbo);
+  bindNewVertexArray(propVao, propVbo);
   setupVertexLayout();
-
-  glGenVertexArrays(1, &patchVao);
-  glGenBuffers(1, &patchVbo);
-  glBindVertexArray(patchVao);
-  glBindBuffer(GL_ARRAY_BUFFER, patchVbo);
+  bindNewVertexArray(patchVao, patchVbo);
   floatAttribute<PatchVertex>(0, 3, offsetof(PatchVertex, pos));
   floatAttribute<PatchVertex>(1, 3, offsetof(PatchVertex, normal));
   floatAttribute<PatchVertex>(2, 2, offsetof(PatchVertex, uv));
   floatAttribute<PatchVertex>(3, 2, offsetof(PatchVertex, maskUv));
-
-  glGenVertexArrays(1, &overlayVao);
-  glGenBuffers(1, &overlayVbo);
-  glBindVertexArray(overlayVao);
-  glBindBuffer(GL_ARRAY_BUFFER, overlayVbo);
-  const auto stride = static_cast<GLsizei>(sizeof(detail::OverlayVertex));
-  glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, stride,
-                        reinterpret_cast<const void*>(offsetof(detail::OverlayVertex, clip)));
-  glEnableVertexAttribArray(1);
-  glVertexAttribPointer(1, 4, GL_UNSIGNED_BYTE, GL_TRUE, stride,
-                        reinterpret_cast<const void*>(offsetof(detail::OverlayVertex, color)));
-  glBindVertexArray(0);
-
-  glGenTextures(1, &paperTex);
-  glGenTextures(1, &maskTex);
-  glGenBuffers(1, &triColorBuffer);
-  glGenTextures(1, &triColorTex);
+  bindNewVertexArray(overlayVao, overlayVbo);
 }
 
 void OsmesaRenderer::Impl::uploadTriangleColors(const std::vector<Vec3>& colors) {
