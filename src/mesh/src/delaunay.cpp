@@ -16,6 +16,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "crumple/core/index.hpp"
+
 namespace crumple::mesh {
 namespace {
 
@@ -37,7 +39,7 @@ using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Kernel, Tds, CGAL::Exact_
 using FaceHandle = Cdt::Face_handle;
 
 std::string pointName(const std::vector<Vec2>& points, int i) {
-  const Vec2& p = points[static_cast<std::size_t>(i)];
+  const Vec2& p = points[idx(i)];
   return "point " + std::to_string(i) + " (" + std::to_string(p.x()) + ", " +
          std::to_string(p.y()) + ")";
 }
@@ -50,7 +52,7 @@ void rejectDuplicates(const std::vector<Vec2>& points) {
   const double eps = 1e-12 * box.diagonal().norm();
   std::vector<int> order(points.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-  const auto at = [&](int i) -> const Vec2& { return points[static_cast<std::size_t>(i)]; };
+  const auto at = [&](int i) -> const Vec2& { return points[idx(i)]; };
   std::sort(order.begin(), order.end(),
             [&](int a, int b) { return at(a).x() != at(b).x() ? at(a).x() < at(b).x() : a < b; });
   for (std::size_t i = 0; i < order.size(); ++i)
@@ -97,10 +99,8 @@ void markDomains(Cdt& cdt) {
 
 // The input point (other than a and b) lying on segment ab, or -1.
 int pointOnSegment(const std::vector<Vec2>& points, int a, int b) {
-  const Kernel::Point_2 pa(points[static_cast<std::size_t>(a)].x(),
-                           points[static_cast<std::size_t>(a)].y());
-  const Kernel::Point_2 pb(points[static_cast<std::size_t>(b)].x(),
-                           points[static_cast<std::size_t>(b)].y());
+  const Kernel::Point_2 pa(points[idx(a)].x(), points[idx(a)].y());
+  const Kernel::Point_2 pb(points[idx(b)].x(), points[idx(b)].y());
   const Kernel::Segment_2 s(pa, pb);
   for (std::size_t i = 0; i < points.size(); ++i) {
     if (static_cast<int>(i) == a || static_cast<int>(i) == b) continue;
@@ -116,7 +116,7 @@ std::vector<std::array<int, 3>> constrainedDelaunay(
     const std::vector<Vec2>& points, const std::vector<std::array<int, 2>>& constraints) {
   const int n = static_cast<int>(points.size());
   for (int i = 0; i < n; ++i)
-    if (!points[static_cast<std::size_t>(i)].allFinite())
+    if (!points[idx(i)].allFinite())
       throw std::invalid_argument("constrainedDelaunay: point " + std::to_string(i) +
                                   " is not finite");
   for (std::size_t k = 0; k < constraints.size(); ++k) {
@@ -134,17 +134,16 @@ std::vector<std::array<int, 3>> constrainedDelaunay(
   std::vector<Cdt::Vertex_handle> handles(points.size());
   FaceHandle hint;
   for (int i = 0; i < n; ++i) {
-    const Vec2& p = points[static_cast<std::size_t>(i)];
+    const Vec2& p = points[idx(i)];
     const auto v = cdt.insert(Kernel::Point_2(p.x(), p.y()), hint);
     v->info().index = i;
-    handles[static_cast<std::size_t>(i)] = v;
+    handles[idx(i)] = v;
     hint = v->face();
   }
 
   for (std::size_t k = 0; k < constraints.size(); ++k) {
     const auto [a, b] = constraints[k];
-    cdt.insert_constraint(handles[static_cast<std::size_t>(a)],
-                          handles[static_cast<std::size_t>(b)]);
+    cdt.insert_constraint(handles[idx(a)], handles[idx(b)]);
     if (static_cast<int>(cdt.number_of_vertices()) != n)
       throw std::invalid_argument("constrainedDelaunay: constraint " + std::to_string(k) + " (" +
                                   std::to_string(a) + "-" + std::to_string(b) +
@@ -152,7 +151,7 @@ std::vector<std::array<int, 3>> constrainedDelaunay(
   }
   for (std::size_t k = 0; k < constraints.size(); ++k) {
     const auto [a, b] = constraints[k];
-    if (!cdt.is_edge(handles[static_cast<std::size_t>(a)], handles[static_cast<std::size_t>(b)])) {
+    if (!cdt.is_edge(handles[idx(a)], handles[idx(b)])) {
       const int on = pointOnSegment(points, a, b);
       throw std::invalid_argument("constrainedDelaunay: constraint " + std::to_string(k) + " (" +
                                   std::to_string(a) + "-" + std::to_string(b) +

@@ -5,6 +5,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "crumple/core/index.hpp"
+
 namespace crumple::mesh {
 
 namespace {
@@ -33,11 +35,11 @@ std::vector<MeshEdge> buildEdges(const SheetMesh& mesh) {
   std::vector<HalfEdge> halves;
   halves.reserve(mesh.triangles.size() * 3);
   for (int t = 0; t < static_cast<int>(mesh.triangles.size()); ++t) {
-    const auto& tri = mesh.triangles[static_cast<std::size_t>(t)];
-    for (int k = 0; k < 3; ++k) {
-      const int a = tri[static_cast<std::size_t>(k)];
-      const int b = tri[static_cast<std::size_t>((k + 1) % 3)];
-      const int opp = tri[static_cast<std::size_t>((k + 2) % 3)];
+    const auto& tri = mesh.triangles[idx(t)];
+    for (std::size_t k = 0; k < 3; ++k) {
+      const int a = tri[k];
+      const int b = tri[(k + 1) % 3];
+      const int opp = tri[(k + 2) % 3];
       halves.push_back({std::min(a, b), std::max(a, b), t, opp});
     }
   }
@@ -72,7 +74,7 @@ SheetMesh makeRectangleSheet(double width, double height, double maxEdge) {
   const int ny = std::max(1, static_cast<int>(std::ceil(height / maxEdge - 1e-9)));
   SheetMesh m;
   const int corners = (nx + 1) * (ny + 1);
-  m.pattern.reserve(static_cast<std::size_t>(corners + nx * ny));
+  m.pattern.reserve(idx(corners + nx * ny));
   for (int j = 0; j <= ny; ++j)
     for (int i = 0; i <= nx; ++i) m.pattern.emplace_back(width * i / nx, height * j / ny);
   for (int j = 0; j < ny; ++j)
@@ -110,10 +112,9 @@ int nearestPatternVertex(const SheetMesh& mesh, const Vec2& p) {
 PatternLocation locatePattern(const SheetMesh& mesh, const Vec2& p) {
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     const auto& T = mesh.triangles[t];
-    const Vec2 a = mesh.pattern[static_cast<std::size_t>(T[0])];
+    const Vec2 a = mesh.pattern[idx(T[0])];
     Mat2 d;
-    d << mesh.pattern[static_cast<std::size_t>(T[1])] - a,
-        mesh.pattern[static_cast<std::size_t>(T[2])] - a;
+    d << mesh.pattern[idx(T[1])] - a, mesh.pattern[idx(T[2])] - a;
     if (!(std::abs(d.determinant()) > 0.0)) continue;
     const Vec2 l = d.inverse() * (p - a);
     constexpr double kOnBorder = 1e-12;  // relative: p on an edge is inside
@@ -128,10 +129,10 @@ int nearestVertex(const SheetMesh& mesh, const Vec3& p) { return nearestPoint(me
 std::vector<int> vertexNeighbours(const SheetMesh& mesh, int v) {
   std::vector<int> out;
   for (const auto& t : mesh.triangles) {
-    for (int k = 0; k < 3; ++k) {
-      if (t[static_cast<std::size_t>(k)] != v) continue;
-      out.push_back(t[static_cast<std::size_t>((k + 1) % 3)]);
-      out.push_back(t[static_cast<std::size_t>((k + 2) % 3)]);
+    for (std::size_t k = 0; k < 3; ++k) {
+      if (t[k] != v) continue;
+      out.push_back(t[(k + 1) % 3]);
+      out.push_back(t[(k + 2) % 3]);
     }
   }
   std::sort(out.begin(), out.end());
@@ -153,10 +154,8 @@ std::string validate(const SheetMesh& mesh) {
       if (v < 0 || v >= n) return "triangle " + std::to_string(t) + " has an out-of-range vertex";
     if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
       return "triangle " + std::to_string(t) + " repeats a vertex";
-    const Vec2 e1 = mesh.pattern[static_cast<std::size_t>(tri[1])] -
-                    mesh.pattern[static_cast<std::size_t>(tri[0])];
-    const Vec2 e2 = mesh.pattern[static_cast<std::size_t>(tri[2])] -
-                    mesh.pattern[static_cast<std::size_t>(tri[0])];
+    const Vec2 e1 = mesh.pattern[idx(tri[1])] - mesh.pattern[idx(tri[0])];
+    const Vec2 e2 = mesh.pattern[idx(tri[2])] - mesh.pattern[idx(tri[0])];
     if (std::abs(e1.x() * e2.y() - e1.y() * e2.x()) <= 1e-18)
       return "triangle " + std::to_string(t) + " is degenerate in the pattern";
     const int r = mesh.regionOfTriangle[t];
@@ -195,8 +194,7 @@ SheetMesh restoreSheetMesh(StateReader& in) {
     in.fail("a mesh's regions do not match its triangles");
   for (const auto& t : m.triangles)
     for (int v : t)
-      if (v < 0 || static_cast<std::size_t>(v) >= m.pattern.size())
-        in.fail("a triangle's vertex is out of range");
+      if (!inRange(m.pattern, v)) in.fail("a triangle's vertex is out of range");
   return m;
 }
 

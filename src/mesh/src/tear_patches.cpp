@@ -6,6 +6,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "crumple/core/index.hpp"
+
 namespace crumple::mesh {
 
 namespace {
@@ -27,7 +29,7 @@ std::string patchProblem(const TearAtlas& atlas, const TearPatch& p) {
     s << "side " << static_cast<int>(p.side) << " is neither 0 (left) nor 1 (right)";
   } else if (p.lipEdges > 7) {
     s << "lip edges " << static_cast<int>(p.lipEdges) << " has bits beyond the three edges";
-  } else if (p.polygon.size() != 3 + 2 * static_cast<std::size_t>(std::popcount(p.lipEdges))) {
+  } else if (p.polygon.size() != 3 + 2 * idx(std::popcount(p.lipEdges))) {
     s << p.polygon.size() << " polygon points for " << std::popcount(p.lipEdges)
       << " lip edges (3 + 2 per lip edge)";
   } else if (p.rect.width < 1 || p.rect.height < 1 || p.rect.x < 0 || p.rect.y < 0 ||
@@ -50,12 +52,12 @@ Vec2 atlasPosition(const TearAtlas& atlas, const TearPatch& patch, const Vec2& p
 }
 
 std::vector<TearPatchTriangle> tearPatchTriangles(const TearPatch& patch, const SheetMesh& mesh) {
-  const auto& tri = mesh.triangles[static_cast<std::size_t>(patch.triangle)];
+  const auto& tri = mesh.triangles[idx(patch.triangle)];
   std::array<Vec2, 3> p;
   std::array<Vec3, 3> x;
   for (std::size_t k = 0; k < 3; ++k) {
-    p[k] = mesh.pattern[static_cast<std::size_t>(tri[k])];
-    x[k] = mesh.positions[static_cast<std::size_t>(tri[k])];
+    p[k] = mesh.pattern[idx(tri[k])];
+    x[k] = mesh.positions[idx(tri[k])];
   }
   // The triangle's affine map, pattern -> 3D: x0 + J (q - p0).
   Mat2 edges2;
@@ -63,13 +65,10 @@ std::vector<TearPatchTriangle> tearPatchTriangles(const TearPatch& patch, const 
   Eigen::Matrix<double, 3, 2> edges3;
   edges3 << x[1] - x[0], x[2] - x[0];
   const Eigen::Matrix<double, 3, 2> jacobian = edges3 * edges2.inverse();
-  const auto corner = [&](int k) {
-    return TearPatchVertex{x[static_cast<std::size_t>(k)], p[static_cast<std::size_t>(k)], k};
-  };
+  const auto corner = [&](int k) { return TearPatchVertex{x[idx(k)], p[idx(k)], k}; };
   // An outer corner pushed from corner k: placed from that corner.
   const auto outer = [&](const Vec2& q, int k) {
-    return TearPatchVertex{
-        x[static_cast<std::size_t>(k)] + jacobian * (q - p[static_cast<std::size_t>(k)]), q, k};
+    return TearPatchVertex{x[idx(k)] + jacobian * (q - p[idx(k)]), q, k};
   };
   std::vector<TearPatchTriangle> out{{corner(0), corner(1), corner(2)}};
   for (int k = 0; k < 3; ++k) {
@@ -88,8 +87,7 @@ std::string validate(const TearAtlas& atlas) {
   if (!(atlas.texelSize > 0.0) || !std::isfinite(atlas.texelSize))
     return "texel size is not a finite number > 0";
   if (atlas.width < 0 || atlas.height < 0) return "negative atlas size";
-  if (atlas.mask.size() !=
-      static_cast<std::size_t>(atlas.width) * static_cast<std::size_t>(atlas.height))
+  if (atlas.mask.size() != idx(atlas.width) * idx(atlas.height))
     return "mask holds " + std::to_string(atlas.mask.size()) + " texels, not " +
            std::to_string(atlas.width) + " x " + std::to_string(atlas.height);
   for (std::size_t i = 0; i < atlas.mask.size(); ++i)
@@ -112,14 +110,14 @@ std::string validate(const TearAtlas& atlas, const SheetMesh& mesh) {
   for (std::size_t i = 0; i < atlas.patches.size(); ++i) {
     const TearPatch& p = atlas.patches[i];
     const std::string where = "patch " + std::to_string(i) + ": ";
-    if (static_cast<std::size_t>(p.triangle) >= mesh.triangles.size())
+    if (!inRange(mesh.triangles, p.triangle))
       return where + "triangle " + std::to_string(p.triangle) + " is not in the mesh (" +
              std::to_string(mesh.triangles.size()) + " triangles)";
-    const auto& tri = mesh.triangles[static_cast<std::size_t>(p.triangle)];
+    const auto& tri = mesh.triangles[idx(p.triangle)];
     for (int k = 0; k < 3; ++k) {
-      const auto v = static_cast<std::size_t>(tri[static_cast<std::size_t>(k)]);
-      if (v >= mesh.pattern.size()) return where + "its triangle's vertex is not in the mesh";
-      const Vec2& q = mesh.pattern[v];
+      const int v = tri[idx(k)];
+      if (!inRange(mesh.pattern, v)) return where + "its triangle's vertex is not in the mesh";
+      const Vec2& q = mesh.pattern[idx(v)];
       if ((p.polygon[cornerIndex(p.lipEdges, k)] - q).norm() > 1e-9 * (1.0 + q.norm()))
         return where + "polygon corner " + std::to_string(k) +
                " is not at its triangle's pattern corner";
@@ -140,7 +138,7 @@ double sampleTearMask(const TearAtlas& atlas, const Vec2& position) {
   const std::size_t x0 = clampTo(fx, w), x1 = clampTo(fx + 1.0, w);
   const std::size_t y0 = clampTo(fy, h), y1 = clampTo(fy + 1.0, h);
   const auto texel = [&](std::size_t xi, std::size_t yi) {
-    return atlas.mask[yi * static_cast<std::size_t>(w) + xi] / 255.0;
+    return atlas.mask[yi * idx(w) + xi] / 255.0;
   };
   return (1.0 - ay) * ((1.0 - ax) * texel(x0, y0) + ax * texel(x1, y0)) +
          ay * ((1.0 - ax) * texel(x0, y1) + ax * texel(x1, y1));

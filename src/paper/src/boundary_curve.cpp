@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "crumple/core/error.hpp"
+#include "crumple/core/index.hpp"
 
 namespace crumple::paper {
 
@@ -123,7 +124,7 @@ double BoundaryCurve::spacing(std::size_t k) const {
 std::size_t BoundaryCurve::interval(double s) const {
   const auto it = std::upper_bound(s_.begin(), s_.end(), s);
   if (it == s_.begin()) return s_.size() - 1;  // before the first sample: the wrapping interval
-  return static_cast<std::size_t>(it - s_.begin()) - 1;
+  return idx(it - s_.begin()) - 1;
 }
 
 BoundaryCurve::Span BoundaryCurve::locate(double s) const {

@@ -12,6 +12,7 @@
 #include "cone_runs.hpp"
 #include "crumple/core/error.hpp"
 #include "crumple/core/geometry2d.hpp"
+#include "crumple/core/index.hpp"
 #include "crumple/paper/compression.hpp"
 
 namespace crumple::paper {
@@ -167,10 +168,7 @@ void segmentRange(std::span<const RulingPlane> planes, double tolerance, const F
   const int minSize = shareBorders ? 2 : 1;
   int f = front;
   int b = back;
-  const auto fitRange = [&] {
-    return fitApex(planes.subspan(static_cast<std::size_t>(f), static_cast<std::size_t>(b - f + 1)),
-                   frame);
-  };
+  const auto fitRange = [&] { return fitApex(planes.subspan(idx(f), idx(b - f + 1)), frame); };
   ApexFit fit = fitRange();
   while (fit.maxDistance > tolerance && b - f + 1 > minSize) {
     // Drop the end ruling whose tangent plane is farther from the apex.
@@ -274,10 +272,8 @@ Vec2 directionInPattern(const Vec3& direction, const RulingGeometry& ruling) {
 // paper Sec. 6.2: the ruling r_j of minimal contribution e_j carries the apex.
 PatternApex patternApex(const ConeSegment& segment, std::span<const RulingGeometry> rulings,
                         ApexMapping mapping) {
-  if (segment.first < 0 || segment.last < segment.first ||
-      static_cast<std::size_t>(segment.last) >= rulings.size() ||
-      segment.fit.contributions.size() !=
-          static_cast<std::size_t>(segment.last - segment.first + 1)) {
+  if (segment.first < 0 || segment.last < segment.first || !inRange(rulings, segment.last) ||
+      segment.fit.contributions.size() != idx(segment.last - segment.first + 1)) {
     throw std::invalid_argument("patternApex: segment does not match the rulings");
   }
   const std::vector<double>& e = segment.fit.contributions;
@@ -286,7 +282,7 @@ PatternApex patternApex(const ConeSegment& segment, std::span<const RulingGeomet
   // e.g. exact data where every e_j is rounding noise): the one whose 3D
   // line passes closest to the apex (most parallel to it at infinity).
   const auto offLine = [&](std::size_t i) {
-    const RulingGeometry& r = rulings[static_cast<std::size_t>(segment.first) + i];
+    const RulingGeometry& r = rulings[idx(segment.first) + i];
     const Vec3 u = (r.b3 - r.a3).normalized();
     if (segment.fit.atInfinity) return u.cross(segment.fit.direction).norm();
     const Vec3 d = segment.fit.apex - r.a3;
@@ -304,7 +300,7 @@ PatternApex patternApex(const ConeSegment& segment, std::span<const RulingGeomet
   }
   PatternApex out;
   out.ruling = segment.first + static_cast<int>(best);
-  const RulingGeometry& r = rulings[static_cast<std::size_t>(out.ruling)];
+  const RulingGeometry& r = rulings[idx(out.ruling)];
   out.atInfinity = segment.fit.atInfinity;
   if (out.atInfinity) {
     out.direction = directionInPattern(segment.fit.direction, r);
@@ -362,9 +358,7 @@ void orientRulings(const GeometricMesh& g, std::vector<Ruling>& rulings) {
     } else if (r.a == p.b || r.b == p.a) {
       flip = true;
     } else {
-      const auto P = [&](int v) -> const Vec2& {
-        return g.vertices[static_cast<std::size_t>(v)].pattern;
-      };
+      const auto P = [&](int v) -> const Vec2& { return g.vertices[idx(v)].pattern; };
       flip = (P(r.b) - P(p.a)).norm() + (P(r.a) - P(p.b)).norm() <
              (P(r.a) - P(p.a)).norm() + (P(r.b) - P(p.b)).norm();
     }
@@ -375,18 +369,16 @@ void orientRulings(const GeometricMesh& g, std::vector<Ruling>& rulings) {
 // thesis 2.5.2: marks the vertices the resampling keeps; returns the region's faces by vertex set.
 std::map<std::vector<int>, int> markFixedVertices(const GeometricMesh& g, int region,
                                                   RegionContext& ctx) {
-  const int nv = static_cast<int>(g.vertices.size());
-  ctx.fixedVertex.assign(static_cast<std::size_t>(nv), 0);
-  for (int v = 0; v < nv; ++v) {
-    const GeometricVertex& gv = g.vertices[static_cast<std::size_t>(v)];
-    ctx.fixedVertex[static_cast<std::size_t>(v)] = gv.handle || gv.singular || gv.corner;
+  ctx.fixedVertex.assign(g.vertices.size(), 0);
+  for (std::size_t v = 0; v < g.vertices.size(); ++v) {
+    const GeometricVertex& gv = g.vertices[v];
+    ctx.fixedVertex[v] = gv.handle || gv.singular || gv.corner;
   }
   std::map<std::vector<int>, int> faceOf;  // sorted vertex set -> face of this region
   for (std::size_t f = 0; f < g.faces.size(); ++f) {
     const GeometricFace& face = g.faces[f];
     if (face.region != region) {
-      for (int k = 0; k < face.size(); ++k)
-        ctx.fixedVertex[static_cast<std::size_t>(face.v[k])] = 1;
+      for (int k = 0; k < face.size(); ++k) ctx.fixedVertex[idx(face.v[k])] = 1;
       continue;
     }
     std::vector<int> key(face.v.begin(), face.v.begin() + face.size());
@@ -432,7 +424,7 @@ std::vector<std::pair<int, int>> boundaryRuns(const GeometricMesh& g,
     if (!e.interior()) boundaryEdges.insert({e.v[0], e.v[1]});
   }
   const auto onBoundary = [&](int v) {
-    const GeometricVertex& gv = g.vertices[static_cast<std::size_t>(v)];
+    const GeometricVertex& gv = g.vertices[idx(v)];
     return gv.onBoundary && gv.outlineSegment >= 0 &&
            gv.outlineSegment < static_cast<int>(g.outline.size());
   };
@@ -441,15 +433,15 @@ std::vector<std::pair<int, int>> boundaryRuns(const GeometricMesh& g,
   };
   std::vector<std::pair<int, int>> runs;
   for (int k = 0; k < static_cast<int>(nr);) {
-    const Ruling& r = rulings[static_cast<std::size_t>(k)];
+    const Ruling& r = rulings[idx(k)];
     if (!onBoundary(r.a) || !onBoundary(r.b)) {
       ++k;
       continue;
     }
     int e = k;
     while (e + 1 < static_cast<int>(nr)) {
-      const Ruling& p = rulings[static_cast<std::size_t>(e)];
-      const Ruling& q = rulings[static_cast<std::size_t>(e + 1)];
+      const Ruling& p = rulings[idx(e)];
+      const Ruling& q = rulings[idx(e + 1)];
       if (!onBoundary(q.a) || !onBoundary(q.b) || !sideOnBoundary(p.a, q.a) ||
           !sideOnBoundary(p.b, q.b))
         break;
@@ -468,11 +460,10 @@ std::vector<Ruling> runRulings(GeometricMesh& g, const BoundaryCurve& curve,
   // Velocities of the old chain vertices, to interpolate along each chain.
   std::array<std::vector<std::pair<double, Vec3>>, 2> velocity;
   for (int k = run.first; k <= run.second; ++k) {
-    const Ruling& r = ctx.rulings[static_cast<std::size_t>(k)];
+    const Ruling& r = ctx.rulings[idx(k)];
     for (std::size_t c = 0; c < 2; ++c) {
       const int v = c == 0 ? r.a : r.b;
-      velocity[c].emplace_back(rr.chains[c].tOf(vertexS(g, v)),
-                               g.vertices[static_cast<std::size_t>(v)].velocity);
+      velocity[c].emplace_back(rr.chains[c].tOf(vertexS(g, v)), g.vertices[idx(v)].velocity);
     }
   }
   std::array<std::map<double, int>, 2> created;
@@ -527,7 +518,7 @@ std::vector<Ruling> spliceRuns(const std::vector<Ruling>& old,
       ++run;
       continue;
     }
-    rulings.push_back(old[static_cast<std::size_t>(k)]);
+    rulings.push_back(old[idx(k)]);
     ++k;
   }
   return rulings;
@@ -537,9 +528,7 @@ std::vector<Ruling> spliceRuns(const std::vector<Ruling>& old,
 bool refittedFacesValid(const GeometricMesh& g, const std::vector<Ruling>& old,
                         const std::vector<Ruling>& rulings) {
   const std::size_t nr = old.size();
-  const auto P = [&](int v) -> const Vec2& {
-    return g.vertices[static_cast<std::size_t>(v)].pattern;
-  };
+  const auto P = [&](int v) -> const Vec2& { return g.vertices[idx(v)].pattern; };
   double sign = 0.0;
   for (std::size_t k = 0; k + 1 < nr && sign == 0.0; ++k) {
     const Ruling& r0 = old[k];
@@ -577,10 +566,10 @@ bool refittedFacesValid(const GeometricMesh& g, const std::vector<Ruling>& old,
 // paper Sec. 6.2 (last paragraphs), Fig. 15; thesis 2.5.2, Fig. 2.19.
 ConeRefitResult refitCurvedRegion(GeometricMesh& g, int region, const BoundaryCurve& curve,
                                   const CrumpleParams& params, double paperLength) {
-  if (region < 0 || static_cast<std::size_t>(region) >= g.regions.size()) {
+  if (!inRange(g.regions, region)) {
     throw std::out_of_range("refitCurvedRegion: region index out of range");
   }
-  const Region& reg = g.regions[static_cast<std::size_t>(region)];
+  const Region& reg = g.regions[idx(region)];
   if (reg.type != mesh::RegionType::Curved)
     throw std::invalid_argument("refitCurvedRegion: not a curved region");
   if (!(paperLength > 0.0) || !std::isfinite(paperLength)) {
@@ -660,7 +649,7 @@ ConeRefitResult refitCurvedRegion(GeometricMesh& g, int region, const BoundaryCu
   }
 
   // Commit.
-  Region& target = g.regions[static_cast<std::size_t>(region)];
+  Region& target = g.regions[idx(region)];
   target.rulings = std::move(rulings);
   rebuildCurvedFaces(g, region);
   result.changed = true;
@@ -678,9 +667,9 @@ ConeRefitResult refitCurvedRegion(GeometricMesh& g, int region, const BoundaryCu
 
 double worstRulingCompression(const GeometricMesh& g, int region) {
   double worst = 0.0;
-  for (const Ruling& r : g.regions.at(static_cast<std::size_t>(region)).rulings) {
-    const GeometricVertex& a = g.vertices.at(static_cast<std::size_t>(r.a));
-    const GeometricVertex& b = g.vertices.at(static_cast<std::size_t>(r.b));
+  for (const Ruling& r : g.regions.at(idx(region)).rulings) {
+    const GeometricVertex& a = g.vertices.at(idx(r.a));
+    const GeometricVertex& b = g.vertices.at(idx(r.b));
     worst = std::max(worst, edgeCompression(a.pattern, b.pattern, a.position, b.position));
   }
   return worst;

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <set>
 
+#include "crumple/core/index.hpp"
+
 namespace crumple::paper::cones {
 
 namespace {
@@ -37,22 +39,21 @@ std::string runPlanes(const RegionContext& ctx, int first, int n, RunPlanes& out
   std::vector<RulingPlane>& planes = out.planes;
   std::vector<RulingGeometry>& geometry = out.geometry;
   FitFrame& frame = out.frame;
-  planes.resize(static_cast<std::size_t>(n));
-  geometry.resize(static_cast<std::size_t>(n));
+  planes.resize(idx(n));
+  geometry.resize(idx(n));
   frame.centre = Vec3::Zero();
   double lengthSum = 0.0;
   for (int k = 0; k < n; ++k) {
-    const Ruling& r = ctx.rulings[static_cast<std::size_t>(first + k)];
-    const GeometricVertex& va = g.vertices[static_cast<std::size_t>(r.a)];
-    const GeometricVertex& vb = g.vertices[static_cast<std::size_t>(r.b)];
-    const Vec3 normal = ctx.rulingNormal[static_cast<std::size_t>(first + k)];
+    const Ruling& r = ctx.rulings[idx(first + k)];
+    const GeometricVertex& va = g.vertices[idx(r.a)];
+    const GeometricVertex& vb = g.vertices[idx(r.b)];
+    const Vec3 normal = ctx.rulingNormal[idx(first + k)];
     const Vec3 mid = 0.5 * (va.position + vb.position);
     const Vec3 d = vb.position - va.position;
     if (!(d.norm() > 0.0) || !((vb.pattern - va.pattern).norm() > 0.0))
       return "a ruling has zero length";
-    planes[static_cast<std::size_t>(k)] = {normal, -normal.dot(mid), d.normalized()};
-    geometry[static_cast<std::size_t>(k)] = {va.position, vb.position, va.pattern, vb.pattern,
-                                             normal};
+    planes[idx(k)] = {normal, -normal.dot(mid), d.normalized()};
+    geometry[idx(k)] = {va.position, vb.position, va.pattern, vb.pattern, normal};
     frame.centre += mid;
     lengthSum += d.norm();
   }
@@ -67,7 +68,7 @@ std::string runPlanes(const RegionContext& ctx, int first, int n, RunPlanes& out
 // Outline parameter of a boundary vertex (paper Sec. 6.2: the boundary
 // curve is parametrized along dS).
 double vertexS(const GeometricMesh& g, int v) {
-  const GeometricVertex& gv = g.vertices[static_cast<std::size_t>(v)];
+  const GeometricVertex& gv = g.vertices[idx(v)];
   return wrapPositive(outlineParameter(g, gv.pattern, gv.outlineSegment), outlinePerimeter(g));
 }
 
@@ -82,12 +83,8 @@ Vec3 polygonNormal(const GeometricMesh& g, const Ruling& r0, const Ruling& r1) {
   }
   if (v.size() > 1 && v.back() == v.front()) v.pop_back();
   if (v.size() < 3) return Vec3::Zero();
-  const auto P = [&](std::size_t k) -> const Vec3& {
-    return g.vertices[static_cast<std::size_t>(v[k])].position;
-  };
-  const auto Q = [&](std::size_t k) -> const Vec2& {
-    return g.vertices[static_cast<std::size_t>(v[k])].pattern;
-  };
+  const auto P = [&](std::size_t k) -> const Vec3& { return g.vertices[idx(v[k])].position; };
+  const auto Q = [&](std::size_t k) -> const Vec2& { return g.vertices[idx(v[k])].pattern; };
   Vec3 n = v.size() == 3 ? Vec3((P(1) - P(0)).cross(P(2) - P(0)))
                          : Vec3((P(2) - P(0)).cross(P(3) - P(1)));
   double area = 0.0;
@@ -99,9 +96,9 @@ Vec3 polygonNormal(const GeometricMesh& g, const Ruling& r0, const Ruling& r1) {
 
 // The current (original) ruling k of the run in chain coordinates.
 ChainRuling RunRefitter::original(int k) const {
-  const Ruling& r = ctx_.rulings[static_cast<std::size_t>(first_ + k)];
+  const Ruling& r = ctx_.rulings[idx(first_ + k)];
   ChainRuling out;
-  out.t = t_[static_cast<std::size_t>(k)];
+  out.t = t_[idx(k)];
   out.v = {r.a, r.b};
   return out;
 }
@@ -111,38 +108,37 @@ ChainRuling RunRefitter::original(int k) const {
 std::string RunRefitter::buildChains() {
   const GeometricMesh& g = *ctx_.g;
   const int n = last_ - first_ + 1;
-  t_.assign(static_cast<std::size_t>(n), {0.0, 0.0});
+  t_.assign(idx(n), {0.0, 0.0});
   for (int c = 0; c < 2; ++c) {
     std::vector<int> verts;
     std::vector<double> s;
     for (int k = 0; k < n; ++k) {
-      const Ruling& r = ctx_.rulings[static_cast<std::size_t>(first_ + k)];
+      const Ruling& r = ctx_.rulings[idx(first_ + k)];
       verts.push_back(c == 0 ? r.a : r.b);
       s.push_back(vertexS(g, verts.back()));
     }
     // Direction along dS: the sum of the wrapped steps.
     double total = 0.0;
     for (int k = 0; k + 1 < n; ++k) {
-      double d = wrapPositive(s[static_cast<std::size_t>(k + 1)] - s[static_cast<std::size_t>(k)],
-                              ctx_.perimeter);
+      double d = wrapPositive(s[idx(k + 1)] - s[idx(k)], ctx_.perimeter);
       if (d > 0.5 * ctx_.perimeter) d -= ctx_.perimeter;
       total += d;
     }
-    Chain& chain = chains_[static_cast<std::size_t>(c)];
+    Chain& chain = chains_[idx(c)];
     chain.g = &g;
     chain.perimeter = ctx_.perimeter;
     chain.s0 = s.front();
     chain.sigma = total < 0.0 ? -1 : 1;
     double prev = 0.0;
     for (int k = 0; k < n; ++k) {
-      double t = chain.tOf(s[static_cast<std::size_t>(k)]);
-      if (verts[static_cast<std::size_t>(k)] == verts.front()) t = 0.0;
+      double t = chain.tOf(s[idx(k)]);
+      if (verts[idx(k)] == verts.front()) t = 0.0;
       // A vertex at the very start seen across the wrap.
       if (t > ctx_.perimeter - 1e-12 * ctx_.perimeter) t = 0.0;
       if (t < prev - 1e-12 * ctx_.perimeter)
         return "a boundary chain of the region is not monotone along dS";
       t = std::max(t, prev);
-      t_[static_cast<std::size_t>(k)][static_cast<std::size_t>(c)] = t;
+      t_[idx(k)][idx(c)] = t;
       prev = t;
     }
     chain.length = prev;
@@ -156,11 +152,10 @@ std::string RunRefitter::buildChains() {
     // Fixed vertices strictly inside the chain.
     std::set<int> seen;
     for (int k = 1; k + 1 < n; ++k) {
-      const int v = verts[static_cast<std::size_t>(k)];
+      const int v = verts[idx(k)];
       if (v == verts.front() || v == verts.back() || !seen.insert(v).second) continue;
-      if (ctx_.fixedVertex[static_cast<std::size_t>(v)]) {
-        fixed_[static_cast<std::size_t>(c)].push_back(
-            {t_[static_cast<std::size_t>(k)][static_cast<std::size_t>(c)], v});
+      if (ctx_.fixedVertex[idx(v)]) {
+        fixed_[idx(c)].push_back({t_[idx(k)][idx(c)], v});
       }
     }
   }
@@ -171,8 +166,8 @@ std::string RunRefitter::buildChains() {
 // chain c meets the other chain (the resampled ruling endpoint).
 std::optional<double> RunRefitter::pencilHit(const Pencil& pencil, int c, double t, double lo,
                                              double hi, double guess) const {
-  const Chain& from = chains_[static_cast<std::size_t>(c)];
-  const Chain& to = chains_[static_cast<std::size_t>(1 - c)];
+  const Chain& from = chains_[idx(c)];
+  const Chain& to = chains_[idx(1 - c)];
   const Vec2 p = from.point(t);
   const std::optional<Vec2> dir = pencil.through(p, 1e-9 * ctx_.spacing);
   if (!dir) return std::nullopt;
@@ -186,24 +181,24 @@ void RunRefitter::fanInterior(int c, double t, int v, double lo, double hi,
                               std::vector<ChainRuling>& out) const {
   const int o = 1 - c;
   std::vector<FixedPoint> stops{{lo, -1}};
-  for (const FixedPoint& f : fixed_[static_cast<std::size_t>(o)]) {
+  for (const FixedPoint& f : fixed_[idx(o)]) {
     if (f.t > lo + eps_ && f.t < hi - eps_) stops.push_back(f);
   }
   stops.push_back({hi, -1});
   for (std::size_t k = 0; k + 1 < stops.size(); ++k) {
     if (k > 0) {
       ChainRuling r;
-      r.t[static_cast<std::size_t>(c)] = t;
-      r.v[static_cast<std::size_t>(c)] = v;
-      r.t[static_cast<std::size_t>(o)] = stops[k].t;
-      r.v[static_cast<std::size_t>(o)] = stops[k].v;
+      r.t[idx(c)] = t;
+      r.v[idx(c)] = v;
+      r.t[idx(o)] = stops[k].t;
+      r.v[idx(o)] = stops[k].v;
       out.push_back(r);
     }
     for (double tt : uniformInterior(stops[k].t, stops[k + 1].t, ctx_.spacing)) {
       ChainRuling r;
-      r.t[static_cast<std::size_t>(c)] = t;
-      r.v[static_cast<std::size_t>(c)] = v;
-      r.t[static_cast<std::size_t>(o)] = tt;
+      r.t[idx(c)] = t;
+      r.v[idx(c)] = v;
+      r.t[idx(o)] = tt;
       out.push_back(r);
     }
   }
@@ -219,8 +214,8 @@ std::string RunRefitter::coneInterior(const Pencil& pencil, const ChainRuling& s
   if (len0 <= eps_ && len1 <= eps_) return {};
   const int c = len0 >= len1 ? 0 : 1;  // driver: the longer side
   const int o = 1 - c;
-  const auto cu = static_cast<std::size_t>(c);
-  const auto ou = static_cast<std::size_t>(o);
+  const auto cu = idx(c);
+  const auto ou = idx(o);
   if ((o == 0 ? len0 : len1) <= eps_) {
     // The cone degenerates to a fan from a point of the other chain.
     fanInterior(o, s.t[ou], s.v[ou], s.t[cu], e.t[cu], out);
@@ -232,7 +227,7 @@ std::string RunRefitter::coneInterior(const Pencil& pencil, const ChainRuling& s
   // Rulings through the fixed vertices inside the cone, aimed at its apex.
   std::vector<ChainRuling> stops{s};
   for (int side = 0; side < 2; ++side) {
-    const auto su = static_cast<std::size_t>(side);
+    const auto su = idx(side);
     for (const FixedPoint& f : fixed_[su]) {
       if (!(f.t > s.t[su] + eps_ && f.t < e.t[su] - eps_)) continue;
       const double guess =
@@ -300,12 +295,11 @@ std::string RunRefitter::fanRun(int apexChain) {
   const int n = last_ - first_ + 1;
   const ChainRuling s = original(0);
   const ChainRuling e = original(n - 1);
-  const auto a = static_cast<std::size_t>(apexChain);
+  const auto a = idx(apexChain);
   const int o = 1 - apexChain;
   std::vector<ChainRuling>& out = out_->rulings;
   out.push_back(s);
-  fanInterior(apexChain, s.t[a], s.v[a], s.t[static_cast<std::size_t>(o)],
-              e.t[static_cast<std::size_t>(o)], out);
+  fanInterior(apexChain, s.t[a], s.v[a], s.t[idx(o)], e.t[idx(o)], out);
   out.push_back(e);
   return {};
 }
@@ -318,31 +312,31 @@ Junction RunRefitter::resolveJunction(int J, bool degraded,
                                       const std::vector<Pencil>& pencils) const {
   const int n = last_ - first_ + 1;
   const int nseg = static_cast<int>(segments.size());
-  const int iL = J == 0 ? 0 : segments[static_cast<std::size_t>(J - 1)].last;
-  const int iR = J == nseg ? n - 1 : segments[static_cast<std::size_t>(J)].first;
+  const int iL = J == 0 ? 0 : segments[idx(J - 1)].last;
+  const int iR = J == nseg ? n - 1 : segments[idx(J)].first;
   Junction out;
   out.left = original(iL);
   out.right = original(iR);
   if (degraded) return out;
-  const Pencil* pl = J == 0 ? nullptr : &pencils[static_cast<std::size_t>(J - 1)];
-  const Pencil* pr = J == nseg ? nullptr : &pencils[static_cast<std::size_t>(J)];
+  const Pencil* pl = J == 0 ? nullptr : &pencils[idx(J - 1)];
+  const Pencil* pr = J == nseg ? nullptr : &pencils[idx(J)];
   std::optional<Junction> best;
   double bestGap = 0.0;
   for (int which : {iL, iR}) {
     for (int c = 0; c < 2; ++c) {
-      const auto cu = static_cast<std::size_t>(c);
-      const auto ou = static_cast<std::size_t>(1 - c);
+      const auto cu = idx(c);
+      const auto ou = idx(1 - c);
       const ChainRuling base = original(which);
       const double tb = base.t[cu];
       const Chain& other = chains_[ou];
       // The line of each side through b = (c, tb) and where it meets the other chain.
-      const auto sideHit = [&](const Pencil* p, int idx) -> std::optional<double> {
+      const auto sideHit = [&](const Pencil* p, int k) -> std::optional<double> {
         if (p == nullptr) {
-          const ChainRuling orig = original(idx);
+          const ChainRuling orig = original(k);
           if (std::abs(orig.t[cu] - tb) > eps_) return std::nullopt;  // b not on the kept ruling
           return orig.t[ou];
         }
-        return pencilHit(*p, c, tb, 0.0, other.length, original(idx).t[ou]);
+        return pencilHit(*p, c, tb, 0.0, other.length, original(k).t[ou]);
       };
       const std::optional<double> hl = sideHit(pl, iL);
       const std::optional<double> hr = sideHit(pr, iR);
@@ -402,23 +396,22 @@ std::string RunRefitter::coneRun() {
   // 4. Junctions J = 0..nseg: before the first cone, between cones, after
   // the last one (paper Fig. 15 last row). L[J] ends the cone before, R[J]
   // starts the cone after; the region's borders are kept.
-  std::vector<char> degraded(static_cast<std::size_t>(nseg + 1), 0);
-  std::vector<Junction> junctions(static_cast<std::size_t>(nseg + 1));
+  std::vector<char> degraded(idx(nseg + 1), 0);
+  std::vector<Junction> junctions(idx(nseg + 1));
   for (bool again = true; again;) {
     again = false;
     for (int J = 0; J <= nseg; ++J)
-      junctions[static_cast<std::size_t>(J)] =
-          resolveJunction(J, degraded[static_cast<std::size_t>(J)], segments, pencils);
+      junctions[idx(J)] = resolveJunction(J, degraded[idx(J)], segments, pencils);
     for (int j = 0; j < nseg; ++j) {
-      const ChainRuling& s = junctions[static_cast<std::size_t>(j)].right;
-      const ChainRuling& e = junctions[static_cast<std::size_t>(j + 1)].left;
+      const ChainRuling& s = junctions[idx(j)].right;
+      const ChainRuling& e = junctions[idx(j + 1)].left;
       if (s.t[0] <= e.t[0] + eps_ && s.t[1] <= e.t[1] + eps_) continue;
       // The cone between would be inverted: keep the original rulings at
       // both of its junctions (shared with the neighbouring cones).
       bool changedHere = false;
       for (int J : {j, j + 1}) {
-        if (!degraded[static_cast<std::size_t>(J)]) {
-          degraded[static_cast<std::size_t>(J)] = 1;
+        if (!degraded[idx(J)]) {
+          degraded[idx(J)] = 1;
           changedHere = true;
         }
       }
@@ -432,10 +425,10 @@ std::string RunRefitter::coneRun() {
   // 5. Assemble: L0 [fan] R0 [cone 0] L1 [fan] R1 ... L_n [fan] R_n.
   std::vector<ChainRuling>& out = out_->rulings;
   for (int J = 0; J <= nseg; ++J) {
-    const Junction& junction = junctions[static_cast<std::size_t>(J)];
+    const Junction& junction = junctions[idx(J)];
     out.push_back(junction.left);
     if (junction.fan) {
-      const auto cu = static_cast<std::size_t>(junction.fanChain);
+      const auto cu = idx(junction.fanChain);
       const auto ou = 1 - cu;
       fanInterior(junction.fanChain, junction.left.t[cu], junction.left.v[cu], junction.left.t[ou],
                   junction.right.t[ou], out);
@@ -445,8 +438,8 @@ std::string RunRefitter::coneRun() {
     }
     out.push_back(junction.right);
     if (J < nseg) {
-      const std::string why = coneInterior(pencils[static_cast<std::size_t>(J)], junction.right,
-                                           junctions[static_cast<std::size_t>(J + 1)].left, out);
+      const std::string why =
+          coneInterior(pencils[idx(J)], junction.right, junctions[idx(J + 1)].left, out);
       if (!why.empty()) return why;
     }
   }

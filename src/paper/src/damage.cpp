@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "crumple/core/index.hpp"
+
 namespace crumple::paper {
 
 // thesis eqs. (2.1)-(2.2)
@@ -15,20 +17,17 @@ std::vector<HingeDamage> fiberDamage(const mesh::SheetMesh& sp,
   // N_i: edges around every vertex (boundary edges included).
   std::vector<int> degree(sp.vertexCount(), 0);
   for (const mesh::MeshEdge& e : mesh::buildEdges(sp)) {
-    ++degree[static_cast<std::size_t>(e.v[0])];
-    ++degree[static_cast<std::size_t>(e.v[1])];
+    ++degree[idx(e.v[0])];
+    ++degree[idx(e.v[1])];
   }
-  const auto isSingular = [&](int v) {
-    return static_cast<std::size_t>(v) < singular.size() &&
-           singular[static_cast<std::size_t>(v)] != 0;
-  };
+  const auto isSingular = [&](int v) { return inRange(singular, v) && singular[idx(v)] != 0; };
   std::vector<HingeDamage> out(hinges.size());
   for (std::size_t h = 0; h < hinges.size(); ++h) {
     double theta = 0.0;
     double d = 0.0;
     for (int v : hinges[h].v) {
       if (!isSingular(v)) continue;
-      const double n = static_cast<double>(std::max(degree[static_cast<std::size_t>(v)], 1));
+      const double n = static_cast<double>(std::max(degree[idx(v)], 1));
       theta += params.thetaRest / n;
       d += params.damage / n;
     }

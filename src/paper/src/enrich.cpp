@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "crumple/core/geometry2d.hpp"
+#include "crumple/core/index.hpp"
 #include "crumple/mesh/delaunay.hpp"
 
 namespace crumple::paper {
@@ -18,13 +19,9 @@ namespace {
 
 using Weights = std::array<double, 4>;
 
-const Vec2& patternOf(const GeometricMesh& g, int v) {
-  return g.vertices[static_cast<std::size_t>(v)].pattern;
-}
+const Vec2& patternOf(const GeometricMesh& g, int v) { return g.vertices[idx(v)].pattern; }
 
-const GeometricFace& faceOf(const GeometricMesh& g, int f) {
-  return g.faces[static_cast<std::size_t>(f)];
-}
+const GeometricFace& faceOf(const GeometricMesh& g, int f) { return g.faces[idx(f)]; }
 
 // Where a pattern point lies in an S_G face: the smallest barycentric
 // coordinate (>= 0 inside) and the weights per face slot, over the fan
@@ -40,8 +37,8 @@ Location locateInFace(const GeometricMesh& g, int f, const Vec2& p) {
   Location best;
   const Vec2& a = patternOf(g, face.v[0]);
   for (int k = 1; k + 1 < face.size(); ++k) {
-    const Vec2& b = patternOf(g, face.v[static_cast<std::size_t>(k)]);
-    const Vec2& c = patternOf(g, face.v[static_cast<std::size_t>(k + 1)]);
+    const Vec2& b = patternOf(g, face.v[idx(k)]);
+    const Vec2& c = patternOf(g, face.v[idx(k + 1)]);
     const double area = cross2(b - a, c - a);
     if (!(area > 0.0)) continue;
     const double lb = cross2(p - a, c - a) / area;
@@ -53,8 +50,8 @@ Location locateInFace(const GeometricMesh& g, int f, const Vec2& p) {
       best.face = f;
       best.weights = Weights{};
       best.weights[0] = la;
-      best.weights[static_cast<std::size_t>(k)] = lb;
-      best.weights[static_cast<std::size_t>(k + 1)] = lc;
+      best.weights[idx(k)] = lb;
+      best.weights[idx(k + 1)] = lc;
     }
   }
   return best;
@@ -92,7 +89,7 @@ class Builder {
       : g_(g), params_(params), edges_(buildEdges(g)) {
     usedByFace_.assign(g.vertexCount(), false);
     for (const GeometricFace& f : g.faces)
-      for (int k = 0; k < f.size(); ++k) usedByFace_[static_cast<std::size_t>(f.v[k])] = true;
+      for (int k = 0; k < f.size(); ++k) usedByFace_[idx(f.v[k])] = true;
   }
 
   PhysicalMesh build() {
@@ -107,7 +104,7 @@ class Builder {
       if (r < 0 || r >= static_cast<int>(g_.regions.size()))
         throw std::invalid_argument("buildPhysicalMesh: S_G face " + std::to_string(f) +
                                     " has unknown region " + std::to_string(r));
-      facesOfRegion[static_cast<std::size_t>(r)].push_back(static_cast<int>(f));
+      facesOfRegion[idx(r)].push_back(static_cast<int>(f));
     }
     for (std::size_t r = 0; r < g_.regions.size(); ++r) {
       const auto& faces = facesOfRegion[r];
@@ -149,8 +146,8 @@ class Builder {
     for (const int f : faces) {
       const GeometricFace& face = faceOf(g_, f);
       for (int k = 0; k < face.size(); ++k) {
-        const int a = face.v[static_cast<std::size_t>(k)];
-        const int b = face.v[static_cast<std::size_t>((k + 1) % face.size())];
+        const int a = face.v[idx(k)];
+        const int b = face.v[idx((k + 1) % face.size())];
         ++uses[{std::min(a, b), std::max(a, b)}];
       }
     }
@@ -160,8 +157,8 @@ class Builder {
       const GeometricFace& face = faceOf(g_, f);
       for (int k = 0; k < face.size(); ++k) {
         const int kb = (k + 1) % face.size();
-        const int a = face.v[static_cast<std::size_t>(k)];
-        const int b = face.v[static_cast<std::size_t>(kb)];
+        const int a = face.v[idx(k)];
+        const int b = face.v[idx(kb)];
         vertices.push_back(a);
         if (uses[{std::min(a, b), std::max(a, b)}] == 1) border.push_back({a, b, f, k, kb});
       }
@@ -209,8 +206,8 @@ class Builder {
         RegionPoint s;
         s.pattern = (1.0 - t) * pa + t * pb;
         s.sample.face = e.face;
-        s.sample.weights[static_cast<std::size_t>(e.slotA)] = 1.0 - t;
-        s.sample.weights[static_cast<std::size_t>(e.slotB)] = t;
+        s.sample.weights[idx(e.slotA)] = 1.0 - t;
+        s.sample.weights[idx(e.slotB)] = t;
         const int local = static_cast<int>(points.size());
         points.push_back(s);
         constraints.push_back({previous, local});
@@ -257,7 +254,7 @@ class Builder {
     // Samples become S_P vertices in local order (only those a triangle uses).
     std::vector<char> used(points.size(), 0);
     for (const auto& t : triangles)
-      for (const int v : t) used[static_cast<std::size_t>(v)] = 1;
+      for (const int v : t) used[idx(v)] = 1;
     std::vector<int> global(points.size(), -1);
     for (std::size_t i = 0; i < points.size(); ++i) {
       if (points[i].geometric >= 0)
@@ -266,13 +263,8 @@ class Builder {
         global[i] = addSample(points[i].pattern, points[i].sample);
     }
     for (const auto& t : triangles) {
-      const std::array<int, 3> tri{global[static_cast<std::size_t>(t[0])],
-                                   global[static_cast<std::size_t>(t[1])],
-                                   global[static_cast<std::size_t>(t[2])]};
-      const Vec2 centroid =
-          (coords[static_cast<std::size_t>(t[0])] + coords[static_cast<std::size_t>(t[1])] +
-           coords[static_cast<std::size_t>(t[2])]) /
-          3.0;
+      const std::array<int, 3> tri{global[idx(t[0])], global[idx(t[1])], global[idx(t[2])]};
+      const Vec2 centroid = (coords[idx(t[0])] + coords[idx(t[1])] + coords[idx(t[2])]) / 3.0;
       addTriangle(tri, region, locate(g_, faces, centroid).face);
     }
   }
@@ -289,16 +281,12 @@ class Builder {
       const auto ccw = [&](const Vec2& a, const Vec2& b, const Vec2& c) {
         return cross2(b - a, c - a) > 1e-18;
       };
-      const auto P = [&](int k) -> const Vec2& {
-        return patternOf(g_, v[static_cast<std::size_t>(k)]);
-      };
+      const auto P = [&](std::size_t k) -> const Vec2& { return patternOf(g_, v[k]); };
       const Vec2 center = 0.25 * (P(0) + P(1) + P(2) + P(3));
       if (ccw(P(0), P(1), center) && ccw(P(1), P(2), center) && ccw(P(2), P(3), center) &&
           ccw(P(3), P(0), center)) {
         const int c = addSample(center, {f, {0.25, 0.25, 0.25, 0.25}});
-        for (int k = 0; k < 4; ++k)
-          addTriangle({v[static_cast<std::size_t>(k)], v[static_cast<std::size_t>((k + 1) % 4)], c},
-                      region, f);
+        for (std::size_t k = 0; k < 4; ++k) addTriangle({v[k], v[(k + 1) % 4], c}, region, f);
       } else if (ccw(P(0), P(1), P(2)) && ccw(P(0), P(2), P(3))) {
         // A non-convex quad (its barycenter outside a corner triangle): split on a diagonal.
         addTriangle({v[0], v[1], v[2]}, region, f);
@@ -341,11 +329,10 @@ void updateSamples(PhysicalMesh& p, const GeometricMesh& g, std::vector<Vec3>* v
       if (s.face < 0 || s.face >= static_cast<int>(g.faceCount()))
         throw std::invalid_argument("updateSamples: sample " + std::to_string(k) +
                                     " refers to a missing S_G face");
-      const GeometricFace& face = g.faces[static_cast<std::size_t>(s.face)];
+      const GeometricFace& face = g.faces[idx(s.face)];
       Vec3 x = Vec3::Zero();
       for (int j = 0; j < face.size(); ++j)
-        x += s.weights[static_cast<std::size_t>(j)] *
-             value(g.vertices[static_cast<std::size_t>(face.v[static_cast<std::size_t>(j)])]);
+        x += s.weights[idx(j)] * value(g.vertices[idx(face.v[idx(j)])]);
       out[n + k] = x;
     }
   };
@@ -360,20 +347,16 @@ void updateSamples(PhysicalMesh& p, const GeometricMesh& g, std::vector<Vec3>* v
 std::vector<double> sliverHingeFactors(const mesh::SheetMesh& sp,
                                        const std::vector<mesh::MeshEdge>& hinges, double ratio) {
   const auto area = [&](int t) {
-    const auto& tri = sp.triangles[static_cast<std::size_t>(t)];
-    const Vec2 a =
-        sp.pattern[static_cast<std::size_t>(tri[1])] - sp.pattern[static_cast<std::size_t>(tri[0])];
-    const Vec2 b =
-        sp.pattern[static_cast<std::size_t>(tri[2])] - sp.pattern[static_cast<std::size_t>(tri[0])];
+    const auto& tri = sp.triangles[idx(t)];
+    const Vec2 a = sp.pattern[idx(tri[1])] - sp.pattern[idx(tri[0])];
+    const Vec2 b = sp.pattern[idx(tri[2])] - sp.pattern[idx(tri[0])];
     return 0.5 * std::abs(a.x() * b.y() - a.y() * b.x());
   };
   std::vector<double> out(hinges.size(), 1.0);
   for (std::size_t h = 0; h < hinges.size(); ++h) {
     const mesh::MeshEdge& e = hinges[h];
     if (!e.interior() || !(ratio > 0.0)) continue;
-    const double len2 = (sp.pattern[static_cast<std::size_t>(e.v[0])] -
-                         sp.pattern[static_cast<std::size_t>(e.v[1])])
-                            .squaredNorm();
+    const double len2 = (sp.pattern[idx(e.v[0])] - sp.pattern[idx(e.v[1])]).squaredNorm();
     out[h] = std::min(1.0, (area(e.triangles[0]) + area(e.triangles[1])) / len2 / ratio);
   }
   return out;

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "crumple/core/geometry2d.hpp"
+#include "crumple/core/index.hpp"
 #include "crumple/paper/compression.hpp"
 #include "crumple/paper/geometric_step.hpp"
 
@@ -20,8 +21,7 @@ int oppositeVertex(const GeometricFace& f, int a, int b) {
 }
 
 bool isFlatTriangle(const GeometricMesh& g, const GeometricFace& f) {
-  return f.size() == 3 &&
-         g.regions[static_cast<std::size_t>(f.region)].type == mesh::RegionType::Flat;
+  return f.size() == 3 && g.regions[idx(f.region)].type == mesh::RegionType::Flat;
 }
 
 }  // namespace
@@ -38,17 +38,17 @@ int flipCompressedEdges(GeometricMesh& g, const CrumpleParams& params) {
     if (!e.interior()) continue;
     const int f0 = e.faces[0];
     const int f1 = e.faces[1];
-    if (touched[static_cast<std::size_t>(f0)] || touched[static_cast<std::size_t>(f1)]) continue;
-    GeometricFace& t0 = g.faces[static_cast<std::size_t>(f0)];
-    GeometricFace& t1 = g.faces[static_cast<std::size_t>(f1)];
+    if (touched[idx(f0)] || touched[idx(f1)]) continue;
+    GeometricFace& t0 = g.faces[idx(f0)];
+    GeometricFace& t1 = g.faces[idx(f1)];
     if (t0.region != t1.region || !isFlatTriangle(g, t0) || !isFlatTriangle(g, t1)) continue;
     const int a = e.v[0];
     const int b = e.v[1];
     const int c = oppositeVertex(t0, a, b);
     const int d = oppositeVertex(t1, a, b);
     const auto& V = g.vertices;
-    const auto P = [&](int v) -> const Vec2& { return V[static_cast<std::size_t>(v)].pattern; };
-    const auto X = [&](int v) -> const Vec3& { return V[static_cast<std::size_t>(v)].position; };
+    const auto P = [&](int v) -> const Vec2& { return V[idx(v)].pattern; };
+    const auto X = [&](int v) -> const Vec3& { return V[idx(v)].position; };
     const double ce1 = edgeCompression(P(a), P(b), X(a), X(b));
     const double ce2 = edgeCompression(P(c), P(d), X(c), X(d));
     if (!(ce1 > params.epsC) || ce2 > params.epsC) continue;
@@ -73,7 +73,7 @@ int flipCompressedEdges(GeometricMesh& g, const CrumpleParams& params) {
     t0.v = {n0[0], n0[1], n0[2], -1};
     t1.v = {n1[0], n1[1], n1[2], -1};
     t0.region = t1.region = region;
-    touched[static_cast<std::size_t>(f0)] = touched[static_cast<std::size_t>(f1)] = 1;
+    touched[idx(f0)] = touched[idx(f1)] = 1;
     ++flips;
   }
   return flips;
@@ -89,29 +89,26 @@ int splitFlatRegions(GeometricMesh& g, const CrumpleParams& params) {
   std::vector<int> parent(g.faces.size());
   std::iota(parent.begin(), parent.end(), 0);
   const auto find = [&](int f) {
-    while (parent[static_cast<std::size_t>(f)] != f) {
-      parent[static_cast<std::size_t>(f)] =
-          parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(f)])];
-      f = parent[static_cast<std::size_t>(f)];
+    while (parent[idx(f)] != f) {
+      parent[idx(f)] = parent[idx(parent[idx(f)])];
+      f = parent[idx(f)];
     }
     return f;
   };
   const auto isFlat = [&](int f) {
-    return g.regions[static_cast<std::size_t>(g.faces[static_cast<std::size_t>(f)].region)].type ==
-           mesh::RegionType::Flat;
+    return g.regions[idx(g.faces[idx(f)].region)].type == mesh::RegionType::Flat;
   };
   for (const GeometricEdge& e : edges) {
     if (!e.interior() || !isFlat(e.faces[0]) || !isFlat(e.faces[1])) continue;
     if (dihedralAngle(g, e.faces[0], e.faces[1]) > params.theta0) continue;
     // Two singular vertices joined by an edge make a crease (Appendix B,
     // Fig. 24 c): it stays a border between flat regions.
-    if (g.vertices[static_cast<std::size_t>(e.v[0])].singular &&
-        g.vertices[static_cast<std::size_t>(e.v[1])].singular) {
+    if (g.vertices[idx(e.v[0])].singular && g.vertices[idx(e.v[1])].singular) {
       continue;
     }
     const int ra = find(e.faces[0]);
     const int rb = find(e.faces[1]);
-    if (ra != rb) parent[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+    if (ra != rb) parent[idx(std::max(ra, rb))] = std::min(ra, rb);
   }
   int before = 0;
   for (const Region& r : g.regions) before += r.type == mesh::RegionType::Flat ? 1 : 0;
@@ -127,14 +124,14 @@ int splitFlatRegions(GeometricMesh& g, const CrumpleParams& params) {
       // Reuse the face's old region id the first time it is seen, else a new one.
       const int old = g.faces[f].region;
       int id = old;
-      if (usedOld[static_cast<std::size_t>(old)]) {
+      if (usedOld[idx(old)]) {
         Region region;
         region.type = mesh::RegionType::Flat;
         g.regions.push_back(region);
         usedOld.push_back(1);
         id = static_cast<int>(g.regions.size()) - 1;
       }
-      usedOld[static_cast<std::size_t>(id)] = 1;
+      usedOld[idx(id)] = 1;
       it = regionOfRoot.emplace(root, id).first;
     }
     g.faces[f].region = it->second;

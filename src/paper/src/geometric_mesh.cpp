@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "crumple/core/geometry2d.hpp"
+#include "crumple/core/index.hpp"
 
 namespace crumple::paper {
 
@@ -52,10 +53,8 @@ std::vector<GeometricEdge> buildEdges(const GeometricMesh& g) {
 }
 
 Vec3 faceNormal(const GeometricMesh& g, int face) {
-  const GeometricFace& f = g.faces[static_cast<std::size_t>(face)];
-  const auto P = [&](int k) -> const Vec3& {
-    return g.vertices[static_cast<std::size_t>(f.v[k])].position;
-  };
+  const GeometricFace& f = g.faces[idx(face)];
+  const auto P = [&](int k) -> const Vec3& { return g.vertices[idx(f.v[k])].position; };
   Vec3 n;
   if (f.size() == 3) {
     n = (P(1) - P(0)).cross(P(2) - P(0));
@@ -73,12 +72,11 @@ double dihedralAngle(const GeometricMesh& g, int faceA, int faceB) {
 }
 
 double patternArea(const GeometricMesh& g, int face) {
-  const GeometricFace& f = g.faces[static_cast<std::size_t>(face)];
+  const GeometricFace& f = g.faces[idx(face)];
   const int n = f.size();
   double area = 0.0;
   for (int k = 0; k < n; ++k) {
-    area += cross2(g.vertices[static_cast<std::size_t>(f.v[k])].pattern,
-                   g.vertices[static_cast<std::size_t>(f.v[(k + 1) % n])].pattern);
+    area += cross2(g.vertices[idx(f.v[k])].pattern, g.vertices[idx(f.v[(k + 1) % n])].pattern);
   }
   return 0.5 * area;
 }
@@ -100,11 +98,11 @@ double outlinePerimeter(const GeometricMesh& g) {
 double outlineParameter(const GeometricMesh& g, const Vec2& p, int segment) {
   const std::size_t n = g.outline.size();
   double s = 0.0;
-  for (std::size_t k = 0; k < static_cast<std::size_t>(segment); ++k) {
+  for (std::size_t k = 0; k < idx(segment); ++k) {
     s += (g.outline[(k + 1) % n] - g.outline[k]).norm();
   }
-  const Vec2& a = g.outline[static_cast<std::size_t>(segment)];
-  const Vec2& b = g.outline[(static_cast<std::size_t>(segment) + 1) % n];
+  const Vec2& a = g.outline[idx(segment)];
+  const Vec2& b = g.outline[(idx(segment) + 1) % n];
   const Vec2 d = b - a;
   const double len = d.norm();
   const double t = std::clamp((p - a).dot(d) / (len * len), 0.0, 1.0);
@@ -142,7 +140,7 @@ void removeRegionFaces(GeometricMesh& g, int region) {
 // (paper Sec. 3.2: quads between boundary vertices, triangles at an apex).
 void rebuildCurvedFaces(GeometricMesh& g, int region) {
   removeRegionFaces(g, region);
-  const std::vector<Ruling>& rulings = g.regions[static_cast<std::size_t>(region)].rulings;
+  const std::vector<Ruling>& rulings = g.regions[idx(region)].rulings;
   for (std::size_t k = 0; k + 1 < rulings.size(); ++k) {
     const Ruling& r0 = rulings[k];
     const Ruling& r1 = rulings[k + 1];
@@ -150,11 +148,11 @@ void rebuildCurvedFaces(GeometricMesh& g, int region) {
     GeometricFace face;
     face.region = region;
     int n = 0;
-    for (int k2 = 0; k2 < 4; ++k2) {
-      const int v = poly[static_cast<std::size_t>(k2)];
-      if (n > 0 && face.v[static_cast<std::size_t>(n - 1)] == v) continue;
+    for (std::size_t k2 = 0; k2 < 4; ++k2) {
+      const int v = poly[k2];
+      if (n > 0 && face.v[idx(n - 1)] == v) continue;
       if (k2 == 3 && v == face.v[0]) continue;
-      face.v[static_cast<std::size_t>(n++)] = v;
+      face.v[idx(n++)] = v;
     }
     if (n < 3) continue;  // two identical rulings: no face
     if (n == 3) face.v[3] = -1;
@@ -169,7 +167,7 @@ void rebuildCurvedFaces(GeometricMesh& g, int region) {
 std::vector<int> compact(GeometricMesh& g) {
   // Regions without faces go (curved regions are kept while they have rulings).
   std::vector<int> faceCount(g.regions.size(), 0);
-  for (const GeometricFace& f : g.faces) ++faceCount[static_cast<std::size_t>(f.region)];
+  for (const GeometricFace& f : g.faces) ++faceCount[idx(f.region)];
   std::vector<int> regionMap(g.regions.size(), -1);
   std::vector<Region> regions;
   for (std::size_t r = 0; r < g.regions.size(); ++r) {
@@ -178,11 +176,11 @@ std::vector<int> compact(GeometricMesh& g) {
     regions.push_back(std::move(g.regions[r]));
   }
   g.regions = std::move(regions);
-  for (GeometricFace& f : g.faces) f.region = regionMap[static_cast<std::size_t>(f.region)];
+  for (GeometricFace& f : g.faces) f.region = regionMap[idx(f.region)];
 
   std::vector<char> used(g.vertices.size(), 0);
   for (const GeometricFace& f : g.faces) {
-    for (int k = 0; k < f.size(); ++k) used[static_cast<std::size_t>(f.v[k])] = 1;
+    for (int k = 0; k < f.size(); ++k) used[idx(f.v[k])] = 1;
   }
   std::vector<int> map(g.vertices.size(), -1);
   std::vector<GeometricVertex> vertices;
@@ -193,14 +191,14 @@ std::vector<int> compact(GeometricMesh& g) {
   }
   g.vertices = std::move(vertices);
   for (GeometricFace& f : g.faces) {
-    for (int k = 0; k < f.size(); ++k) f.v[k] = map[static_cast<std::size_t>(f.v[k])];
+    for (int k = 0; k < f.size(); ++k) f.v[k] = map[idx(f.v[k])];
   }
   for (Region& r : g.regions) {
     for (Ruling& ruling : r.rulings) {
-      ruling.a = map[static_cast<std::size_t>(ruling.a)];
-      ruling.b = map[static_cast<std::size_t>(ruling.b)];
+      ruling.a = map[idx(ruling.a)];
+      ruling.b = map[idx(ruling.b)];
     }
-    if (r.apex >= 0) r.apex = map[static_cast<std::size_t>(r.apex)];
+    if (r.apex >= 0) r.apex = map[idx(r.apex)];
   }
   return map;
 }
@@ -208,8 +206,7 @@ std::vector<int> compact(GeometricMesh& g) {
 std::vector<int> junctionVertices(const GeometricMesh& g) {
   std::vector<std::vector<int>> regionsOf(g.vertices.size());
   for (const GeometricFace& f : g.faces) {
-    for (int k = 0; k < f.size(); ++k)
-      regionsOf[static_cast<std::size_t>(f.v[k])].push_back(f.region);
+    for (int k = 0; k < f.size(); ++k) regionsOf[idx(f.v[k])].push_back(f.region);
   }
   std::vector<int> out;
   for (std::size_t v = 0; v < g.vertices.size(); ++v) {
@@ -218,7 +215,7 @@ std::vector<int> junctionVertices(const GeometricMesh& g) {
     std::sort(rs.begin(), rs.end());
     rs.erase(std::unique(rs.begin(), rs.end()), rs.end());
     const bool curved = std::any_of(rs.begin(), rs.end(), [&](int r) {
-      return g.regions[static_cast<std::size_t>(r)].type == mesh::RegionType::Curved;
+      return g.regions[idx(r)].type == mesh::RegionType::Curved;
     });
     if (curved && rs.size() >= 2) out.push_back(static_cast<int>(v));
   }
@@ -233,7 +230,7 @@ std::string validate(const GeometricMesh& g, double planarityTolerance) {
   if (!(area > 0.0)) return "outline is not counter-clockwise";
   const double perimeter = outlinePerimeter(g);
   for (int v = 0; v < nv; ++v) {
-    const GeometricVertex& gv = g.vertices[static_cast<std::size_t>(v)];
+    const GeometricVertex& gv = g.vertices[idx(v)];
     if (!gv.pattern.allFinite() || !gv.position.allFinite() || !gv.velocity.allFinite()) {
       msg << "vertex " << v << " is not finite";
       return msg.str();
@@ -269,8 +266,7 @@ std::string validate(const GeometricMesh& g, double planarityTolerance) {
       msg << "face " << f << " is degenerate or clockwise in the pattern (area " << a << ")";
       return msg.str();
     }
-    if (face.size() == 4 &&
-        g.regions[static_cast<std::size_t>(face.region)].type != mesh::RegionType::Curved) {
+    if (face.size() == 4 && g.regions[idx(face.region)].type != mesh::RegionType::Curved) {
       msg << "face " << f << " is a quad outside a curved region";
       return msg.str();
     }
@@ -283,7 +279,7 @@ std::string validate(const GeometricMesh& g, double planarityTolerance) {
   {
     std::vector<char> used(g.vertices.size(), 0);
     for (const GeometricFace& f : g.faces) {
-      for (int k = 0; k < f.size(); ++k) used[static_cast<std::size_t>(f.v[k])] = 1;
+      for (int k = 0; k < f.size(); ++k) used[idx(f.v[k])] = 1;
     }
     for (std::size_t v = 0; v < used.size(); ++v) {
       if (!used[v]) {
@@ -301,8 +297,8 @@ std::string validate(const GeometricMesh& g, double planarityTolerance) {
   // Every edge with one face lies on the outline (the faces tile the sheet).
   for (const GeometricEdge& e : edges) {
     if (e.interior()) continue;
-    const GeometricVertex& a = g.vertices[static_cast<std::size_t>(e.v[0])];
-    const GeometricVertex& b = g.vertices[static_cast<std::size_t>(e.v[1])];
+    const GeometricVertex& a = g.vertices[idx(e.v[0])];
+    const GeometricVertex& b = g.vertices[idx(e.v[1])];
     if (!a.onBoundary || !b.onBoundary) {
       msg << "edge (" << e.v[0] << ", " << e.v[1] << ") has one face but is not on the outline";
       return msg.str();
@@ -331,10 +327,10 @@ std::string validate(const GeometricMesh& g, double planarityTolerance) {
   if (planarityTolerance >= 0.0) {
     for (const GeometricEdge& e : edges) {
       if (!e.interior()) continue;
-      const GeometricFace& f0 = g.faces[static_cast<std::size_t>(e.faces[0])];
-      const GeometricFace& f1 = g.faces[static_cast<std::size_t>(e.faces[1])];
+      const GeometricFace& f0 = g.faces[idx(e.faces[0])];
+      const GeometricFace& f1 = g.faces[idx(e.faces[1])];
       if (f0.region != f1.region) continue;
-      if (g.regions[static_cast<std::size_t>(f0.region)].type != mesh::RegionType::Flat) continue;
+      if (g.regions[idx(f0.region)].type != mesh::RegionType::Flat) continue;
       const double angle = dihedralAngle(g, e.faces[0], e.faces[1]);
       if (angle > planarityTolerance) {
         msg << "flat region " << f0.region << " is not planar: dihedral " << angle

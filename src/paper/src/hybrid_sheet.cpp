@@ -14,6 +14,7 @@
 
 #include "crumple/core/error.hpp"
 #include "crumple/core/geometry2d.hpp"
+#include "crumple/core/index.hpp"
 #include "crumple/core/work_budget.hpp"
 #include "crumple/paper/boundary_curve.hpp"
 #include "crumple/paper/cone_fit.hpp"
@@ -93,7 +94,7 @@ void HybridSheet::Impl::carryContacts(const std::vector<sim::ContactSample>& sam
   contacts.clear();
   const auto& pattern = sp.mesh.pattern;
   for (const sim::ContactSample& s : samples) {
-    const Vec2& at = patternBefore[static_cast<std::size_t>(s.vertex)];
+    const Vec2& at = patternBefore[idx(s.vertex)];
     // The vertex at the same material point, else the nearest one.
     std::size_t best = 0;
     double bestDistance = std::numeric_limits<double>::infinity();
@@ -153,13 +154,12 @@ void HybridSheet::setProjectionCallback(std::function<void(const ProjectionInput
 void HybridSheet::placeVertices(const std::vector<sim::Pin>& pins) {
   Impl& m = *impl_;
   for (const sim::Pin& p : pins) {
-    if (static_cast<std::size_t>(p.vertex) < m.sg.vertices.size()) {
-      m.sg.vertices[static_cast<std::size_t>(p.vertex)].position = p.position;
+    if (inRange(m.sg.vertices, p.vertex)) {
+      m.sg.vertices[idx(p.vertex)].position = p.position;
     }
   }
   updateSamples(m.sp, m.sg);
-  for (const sim::Pin& p : pins)
-    m.sp.mesh.positions[static_cast<std::size_t>(p.vertex)] = p.position;
+  for (const sim::Pin& p : pins) m.sp.mesh.positions[idx(p.vertex)] = p.position;
   m.elastic->setPositions(m.sp.mesh.positions);
 }
 
@@ -258,14 +258,11 @@ void HybridSheet::restoreState(StateReader& in) {
     }
   }
   sg.outline = in.vec2s();
-  const auto vertexOk = [&](int v) {
-    return v >= 0 && static_cast<std::size_t>(v) < sg.vertices.size();
-  };
+  const auto vertexOk = [&](int v) { return inRange(sg.vertices, v); };
   for (const auto& f : sg.faces) {
     for (int k = 0; k < f.size(); ++k)
-      if (!vertexOk(f.v[static_cast<std::size_t>(k)])) in.fail("a face's vertex is out of range");
-    if (f.region < 0 || static_cast<std::size_t>(f.region) >= sg.regions.size())
-      in.fail("a face's region is out of range");
+      if (!vertexOk(f.v[idx(k)])) in.fail("a face's vertex is out of range");
+    if (!inRange(sg.regions, f.region)) in.fail("a face's region is out of range");
   }
   for (const auto& r : sg.regions) {
     if (r.apex != -1 && !vertexOk(r.apex)) in.fail("a region's apex is out of range");
@@ -318,17 +315,15 @@ std::optional<std::vector<GeometricCutResult>> HybridSheet::tear(
   const mesh::SheetMesh& sp = m.sp.mesh;
   onSurface.surface = [&](const Vec2& p, Vec3& position, Vec3& velocity) {
     for (const auto& t : sp.triangles) {
-      const Vec2& a = sp.pattern[static_cast<std::size_t>(t[0])];
-      const Vec2& b = sp.pattern[static_cast<std::size_t>(t[1])];
-      const Vec2& c = sp.pattern[static_cast<std::size_t>(t[2])];
+      const Vec2& a = sp.pattern[idx(t[0])];
+      const Vec2& b = sp.pattern[idx(t[1])];
+      const Vec2& c = sp.pattern[idx(t[2])];
       const double area = cross2(b - a, c - a);
       const double wa = cross2(b - p, c - p) / area, wb = cross2(c - p, a - p) / area;
       const double wc = 1.0 - wa - wb;
       if (!(area > 0.0) || wa < -1e-9 || wb < -1e-9 || wc < -1e-9) continue;
-      position = wa * x[static_cast<std::size_t>(t[0])] + wb * x[static_cast<std::size_t>(t[1])] +
-                 wc * x[static_cast<std::size_t>(t[2])];
-      velocity = wa * v[static_cast<std::size_t>(t[0])] + wb * v[static_cast<std::size_t>(t[1])] +
-                 wc * v[static_cast<std::size_t>(t[2])];
+      position = wa * x[idx(t[0])] + wb * x[idx(t[1])] + wc * x[idx(t[2])];
+      velocity = wa * v[idx(t[0])] + wb * v[idx(t[1])] + wc * v[idx(t[2])];
       return true;
     }
     return false;
@@ -383,7 +378,7 @@ void HybridSheet::Impl::elasticStep(double t, double dt, const sim::PinFunction&
     std::vector<sim::Pin> now;
     pins(t, now);
     std::vector<Vec3> x = m.elastic->positions();
-    for (const sim::Pin& p : now) x[static_cast<std::size_t>(p.vertex)] = p.position;
+    for (const sim::Pin& p : now) x[idx(p.vertex)] = p.position;
     m.elastic->setPositions(x);
     stats.elastic = m.elastic->advance(t, dt, pins);
     ++stats.elasticRetries;
@@ -418,9 +413,7 @@ void HybridSheet::Impl::geometricStep(const BoundaryCurve& curve, const std::vec
   checkAfter("flat-region splits");
   const CounterRng rng(m.seed, frame, RngPurpose::SingularityPlacement);
   // Regions cut in the last remeshCooldown steps wait (the cooldown).
-  const FaceFilter settled = [&m](int face) {
-    return !m.holdsRecentCut(m.sg.faces[static_cast<std::size_t>(face)]);
-  };
+  const FaceFilter settled = [&m](int face) { return !m.holdsRecentCut(m.sg.faces[idx(face)]); };
   treatCompression(m.sg, stepParams, boundary, rng, draw, stats.geometric, settled);
   checkAfter("compression treatment");
   treatCurvedCompression(m.sg, stepParams, rng, draw, stats.geometric, settled);
@@ -479,17 +472,13 @@ std::vector<Vec3> HybridSheet::Impl::projectIsometry(double t, const std::vector
   for (const sim::Pin& p : pinned) {
     // Tangent-plane pins are S_P vertices that are not handles: they bind in
     // the elastic step only unless isometryHoldsTangentPins (params.hpp).
-    const auto v = static_cast<std::size_t>(p.vertex);
-    if (!m.params.isometryHoldsTangentPins &&
-        (v >= m.sg.vertices.size() || !m.sg.vertices[v].handle))
-      continue;
+    if (!m.params.isometryHoldsTangentPins && !m.isHandle(p.vertex)) continue;
     fixed.push_back(p.vertex);
   }
   std::sort(fixed.begin(), fixed.end());
   fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
   if (!m.isometry || !m.isometry->sameTopology(m.sp.mesh.triangles, fixed) ||
-      static_cast<std::size_t>(m.isometry->vertexCount()) != m.sp.mesh.vertexCount() ||
-      stats.topologyChanged) {
+      idx(m.isometry->vertexCount()) != m.sp.mesh.vertexCount() || stats.topologyChanged) {
     m.isometry.emplace(m.sp.mesh.pattern, m.sp.mesh.triangles, fixed, m.isometryOptions());
   }
   if (m.onProjection) {

@@ -17,6 +17,7 @@
 
 #include "crumple/core/error.hpp"
 #include "crumple/core/geometry2d.hpp"
+#include "crumple/core/index.hpp"
 #include "crumple/paper/boundary_curve.hpp"
 #include "crumple/paper/damage.hpp"
 #include "crumple/paper/hybrid_sheet.hpp"
@@ -86,10 +87,10 @@ struct HybridSheet::Impl {
 
   // Whether face f holds a recent cut (at one of its vertices or inside it).
   bool holdsRecentCut(const GeometricFace& f) const {
-    const std::span<const int> corners(f.v.data(), static_cast<std::size_t>(f.size()));
+    const std::span<const int> corners(f.v.data(), idx(f.size()));
     for (const auto& [p, left] : recentCuts) {
       for (int v : corners) {
-        if ((sg.vertices[static_cast<std::size_t>(v)].pattern - p).norm() < 1e-9) return true;
+        if ((sg.vertices[idx(v)].pattern - p).norm() < 1e-9) return true;
       }
       if (detail::pointInPolygon(sg, corners, p)) return true;
     }
@@ -135,8 +136,7 @@ struct HybridSheet::Impl {
 
   double traceElasticStrain = 0.0;  // max |r_e| of S_P as the elastic step left it
   void noteHinge(int stage) {
-    if (traceLevel > 0)
-      traceHinge[static_cast<std::size_t>(stage)] = detail::maxHingeAngle(*elastic);
+    if (traceLevel > 0) traceHinge[idx(stage)] = detail::maxHingeAngle(*elastic);
   }
 
   bool undoStretchingGeometry(const mesh::SheetMesh& spBefore, const GeometricMesh& sgBefore,
@@ -166,10 +166,7 @@ struct HybridSheet::Impl {
   // the rig, not catchUpPins').
   void measureLags(const std::vector<sim::Pin>& nodes, const std::vector<Vec3>& x,
                    StrainLimitStats& s) const;
-  bool isHandle(int v) const {
-    return v >= 0 && static_cast<std::size_t>(v) < sg.vertices.size() &&
-           sg.vertices[static_cast<std::size_t>(v)].handle;
-  }
+  bool isHandle(int v) const { return inRange(sg.vertices, v) && sg.vertices[idx(v)].handle; }
   void limitStepStrain(const mesh::SheetMesh& spBefore, const GeometricMesh& sgBefore,
                        const std::vector<sim::Pin>& pinned, int frame, std::vector<Vec3>& positions,
                        HybridStepStats& stats);
@@ -177,8 +174,7 @@ struct HybridSheet::Impl {
   std::vector<char> heldBy(const std::vector<sim::Pin>& pinned) const {
     std::vector<char> out(sp.mesh.vertexCount(), 0);
     for (const sim::Pin& p : pinned)
-      if (static_cast<std::size_t>(p.vertex) < out.size())
-        out[static_cast<std::size_t>(p.vertex)] = 1;
+      if (inRange(out, p.vertex)) out[idx(p.vertex)] = 1;
     return out;
   }
   // The stages of animationStep (paper Fig. 16): (a)-(b) the elastic step, (d)-(e) the
@@ -211,10 +207,8 @@ struct HybridSheet::Impl {
     if (!mp.empty()) throw NumericalError(stage, frame, "S_P invalid: " + mp);
     double area = 0.0;
     for (const auto& t : sp.mesh.triangles) {
-      const Vec2 a = sp.mesh.pattern[static_cast<std::size_t>(t[1])] -
-                     sp.mesh.pattern[static_cast<std::size_t>(t[0])];
-      const Vec2 b = sp.mesh.pattern[static_cast<std::size_t>(t[2])] -
-                     sp.mesh.pattern[static_cast<std::size_t>(t[0])];
+      const Vec2 a = sp.mesh.pattern[idx(t[1])] - sp.mesh.pattern[idx(t[0])];
+      const Vec2 b = sp.mesh.pattern[idx(t[2])] - sp.mesh.pattern[idx(t[0])];
       area += 0.5 * (a.x() * b.y() - a.y() * b.x());
     }
     const double sheet = outlineArea(sg);

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "crumple/core/error.hpp"
+#include "crumple/core/index.hpp"
 #include "crumple/paper/strain_limit.hpp"
 #include "hybrid_sheet_impl.hpp"
 
@@ -153,9 +154,8 @@ sim::PinFunction HybridSheet::Impl::catchUpPins(double t, double dt,
   };
   std::vector<Path> paths;
   for (const sim::Pin& p : after) {
-    if (!isHandle(p.vertex) || static_cast<std::size_t>(p.vertex) >= sp.mesh.positions.size())
-      continue;
-    const Vec3 start = sp.mesh.positions[static_cast<std::size_t>(p.vertex)];
+    if (!isHandle(p.vertex) || !inRange(sp.mesh.positions, p.vertex)) continue;
+    const Vec3 start = sp.mesh.positions[idx(p.vertex)];
     const auto node = std::find_if(before.begin(), before.end(),
                                    [&](const sim::Pin& q) { return q.vertex == p.vertex; });
     // A handle that takes hold in this step starts from where its vertex is.
@@ -191,8 +191,8 @@ void HybridSheet::Impl::measureLags(const std::vector<sim::Pin>& nodes, const st
   s.lagVertex = -1;
   s.handleLags.clear();
   for (const sim::Pin& p : nodes) {
-    if (!isHandle(p.vertex) || static_cast<std::size_t>(p.vertex) >= x.size()) continue;
-    const double d = (x[static_cast<std::size_t>(p.vertex)] - p.position).norm();
+    if (!isHandle(p.vertex) || !inRange(x, p.vertex)) continue;
+    const double d = (x[idx(p.vertex)] - p.position).norm();
     s.handleLags.emplace_back(p.vertex, d);
     if (d > s.lag) {
       s.lag = d;
@@ -214,11 +214,9 @@ void HybridSheet::Impl::limitStepStrain(const mesh::SheetMesh& spBefore,
   std::vector<int> handles, tangentPins;
   std::vector<Vec3> targets;
   for (const sim::Pin& p : pinned) {
-    const auto v = static_cast<std::size_t>(p.vertex);
-    if (v < positions.size() && (v >= m.sg.vertices.size() || !m.sg.vertices[v].handle))
-      tangentPins.push_back(p.vertex);
-    if (v >= m.sg.vertices.size() || !m.sg.vertices[v].handle || v >= spBefore.positions.size())
-      continue;
+    const bool handle = m.isHandle(p.vertex);
+    if (inRange(positions, p.vertex) && !handle) tangentPins.push_back(p.vertex);
+    if (!handle || !inRange(spBefore.positions, p.vertex)) continue;
     handles.push_back(p.vertex);
     targets.push_back(p.position);
   }
@@ -247,7 +245,7 @@ void HybridSheet::Impl::limitStepStrain(const mesh::SheetMesh& spBefore,
     if (!more.empty()) {
       const double alpha = m.keepMoveOutOfItself(before, positions);
       if (!(alpha > 0.0)) more.clear();
-      for (KeepOut& k : more) k.point = positions[static_cast<std::size_t>(k.vertex)];
+      for (KeepOut& k : more) k.point = positions[idx(k.vertex)];
     }
     keepOut.insert(keepOut.end(), more.begin(), more.end());
     return !more.empty();

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "crumple/core/error.hpp"
+#include "crumple/core/index.hpp"
 #include "crumple/mesh/delaunay.hpp"
 
 namespace crumple::paper {
@@ -17,7 +18,7 @@ InitialSheet makeFlatSheet(double width, double height, const std::vector<Vec2>&
   const auto place = [&](const Vec2& p) { return Vec3(origin + p.x() * uAxis + p.y() * vAxis); };
   for (int k = 0; k < 4; ++k) {
     GeometricVertex v;
-    v.pattern = g.outline[static_cast<std::size_t>(k)];
+    v.pattern = g.outline[idx(k)];
     v.position = place(v.pattern);
     v.onBoundary = true;
     v.corner = true;
@@ -51,7 +52,7 @@ InitialSheet makeFlatSheet(double width, double height, const std::vector<Vec2>&
       v.position = place(v.pattern);
       found = addVertex(g, v);
     }
-    g.vertices[static_cast<std::size_t>(found)].handle = true;
+    g.vertices[idx(found)].handle = true;
     out.handleVertices.push_back(found);
   }
   // One flat region: constrained Delaunay of the outline (split at boundary

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "crumple/core/error.hpp"
+#include "crumple/core/index.hpp"
 #include "crumple/core/work_budget.hpp"
 #include "pattern_edges.hpp"
 
@@ -53,14 +54,14 @@ int IsometryProjector::Impl::polishLengths(std::vector<Vec3>& p) const {
   };
   const auto& edges = graph->edges;
   const auto& restLength = graph->restLength;
-  std::vector<char> isFixed(static_cast<std::size_t>(graph->n), 0);
-  for (int v : graph->fixed) isFixed[static_cast<std::size_t>(v)] = 1;
+  std::vector<char> isFixed(idx(graph->n), 0);
+  for (int v : graph->fixed) isFixed[idx(v)] = 1;
   std::vector<Rod> rods;
   rods.reserve(edges.size());
   for (std::size_t e = 0; e < edges.size(); ++e) {
     const int i = edges[e][0], j = edges[e][1];
-    const bool fi = isFixed[static_cast<std::size_t>(i)] == 0;
-    const bool fj = isFixed[static_cast<std::size_t>(j)] == 0;
+    const bool fi = isFixed[idx(i)] == 0;
+    const bool fj = isFixed[idx(j)] == 0;
     if (fi || fj)
       rods.push_back({i, j, fi, fj, restLength[e], (fi ? 1.0 : 0.0) + (fj ? 1.0 : 0.0)});
   }
@@ -69,8 +70,8 @@ int IsometryProjector::Impl::polishLengths(std::vector<Vec3>& p) const {
     checkWorkBudget("isometry");  // the shot's cost guard (core/work_budget.hpp)
     double worst = 0.0;
     for (const Rod& r : rods) {
-      Vec3& pi = p[static_cast<std::size_t>(r.i)];
-      Vec3& pj = p[static_cast<std::size_t>(r.j)];
+      Vec3& pi = p[idx(r.i)];
+      Vec3& pj = p[idx(r.j)];
       const Vec3 d = pj - pi;
       const double len = d.norm();
       if (!(len > 1e-14 * r.rest)) continue;  // a collapsed edge has no direction

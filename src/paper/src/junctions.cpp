@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "crumple/core/geometry2d.hpp"
+#include "crumple/core/index.hpp"
 #include "crumple/paper/geometric_step.hpp"
 #include "region_tools.hpp"
 
@@ -26,9 +27,7 @@ void addFlatCell(GeometricMesh& g, const Ruling& r0, const Ruling& r1, int regio
   std::vector<int> poly{r0.a, r1.a, r1.b, r0.b};
   poly.erase(std::unique(poly.begin(), poly.end()), poly.end());
   if (poly.size() > 1 && poly.front() == poly.back()) poly.pop_back();
-  const auto P = [&](int v) -> const Vec2& {
-    return g.vertices[static_cast<std::size_t>(v)].pattern;
-  };
+  const auto P = [&](int v) -> const Vec2& { return g.vertices[idx(v)].pattern; };
   const auto add = [&](int a, int b, int c) {
     GeometricFace f;
     f.v = {a, b, c, -1};
@@ -62,14 +61,12 @@ bool expandIntoFlat(GeometricMesh& g, int region, bool front, int flat, double t
   const auto loopOpt = regionLoop(g, flat, edges);
   if (!loopOpt) return false;
   Loop loop = *loopOpt;
-  const Region& c = g.regions[static_cast<std::size_t>(region)];
+  const Region& c = g.regions[idx(region)];
   const Ruling r = front ? c.rulings.front() : c.rulings.back();
-  const auto P = [&](int v) -> const Vec2& {
-    return g.vertices[static_cast<std::size_t>(v)].pattern;
-  };
+  const auto P = [&](int v) -> const Vec2& { return g.vertices[idx(v)].pattern; };
   const std::size_t m = loop.size();
   const auto indexOf = [&](int v) {
-    return static_cast<std::size_t>(std::find(loop.v.begin(), loop.v.end(), v) - loop.v.begin());
+    return idx(std::find(loop.v.begin(), loop.v.end(), v) - loop.v.begin());
   };
   const std::size_t ia = indexOf(r.a);
   const std::size_t ib = indexOf(r.b);
@@ -88,8 +85,7 @@ bool expandIntoFlat(GeometricMesh& g, int region, bool front, int flat, double t
   const auto slide = [&](std::size_t i, bool forward) -> std::optional<Move> {
     Move mv;
     mv.from = loop.v[i];
-    if (g.vertices[static_cast<std::size_t>(mv.from)].singular &&
-        !g.vertices[static_cast<std::size_t>(mv.from)].onBoundary) {
+    if (g.vertices[idx(mv.from)].singular && !g.vertices[idx(mv.from)].onBoundary) {
       mv.to = mv.from;  // a cone apex stays
       return mv;
     }
@@ -167,7 +163,7 @@ bool expandIntoFlat(GeometricMesh& g, int region, bool front, int flat, double t
   // new end next to a, avoiding the ruling (a, b).
   const std::size_t n2 = newLoop.size();
   const auto pos = [&](int v) {
-    return static_cast<std::size_t>(std::find(newLoop.begin(), newLoop.end(), v) - newLoop.begin());
+    return idx(std::find(newLoop.begin(), newLoop.end(), v) - newLoop.begin());
   };
   std::vector<int> rest;
   {
@@ -184,7 +180,7 @@ bool expandIntoFlat(GeometricMesh& g, int region, bool front, int flat, double t
   }
   removeRegionFaces(g, flat);
   if (rest.size() >= 3) triangulatePolygon(g, rest, flat, inner);
-  Region& cr = g.regions[static_cast<std::size_t>(region)];
+  Region& cr = g.regions[idx(region)];
   const Ruling added{na, nb};
   if (front) {
     cr.rulings.insert(cr.rulings.begin(), added);
@@ -198,8 +194,7 @@ bool expandIntoFlat(GeometricMesh& g, int region, bool front, int flat, double t
 }  // namespace
 
 double rulingDihedral(const GeometricMesh& g, int region, int k) {
-  const Ruling& r =
-      g.regions[static_cast<std::size_t>(region)].rulings[static_cast<std::size_t>(k)];
+  const Ruling& r = g.regions[idx(region)].rulings[idx(k)];
   const EdgeMap edges = edgeMap(g);
   const auto faces = facesOf(edges, r.a, r.b);
   if (faces[0] < 0 || faces[1] < 0) return 0.0;
@@ -229,7 +224,7 @@ void updateJunctions(GeometricMesh& g, const CrumpleParams& params,
       if (faces[0] >= 0 && faces[1] >= 0) angle[k] = dihedralAngle(g, faces[0], faces[1]);
       if (k == 0 || k + 1 == rulings.size()) {
         for (int f : faces) {
-          if (f >= 0 && g.faces[static_cast<std::size_t>(f)].region != region) outside[k] = f;
+          if (f >= 0 && g.faces[idx(f)].region != region) outside[k] = f;
         }
       }
     }
@@ -250,9 +245,8 @@ void updateJunctions(GeometricMesh& g, const CrumpleParams& params,
     const bool allLow = std::all_of(angle.begin() + 1, angle.end() - 1,
                                     [&](double a) { return a < params.thetaLow; });
     const auto flatOutside = [&](std::size_t k) {
-      return outside[k] >= 0 && g.regions[static_cast<std::size_t>(
-                                              g.faces[static_cast<std::size_t>(outside[k])].region)]
-                                        .type == mesh::RegionType::Flat;
+      return outside[k] >= 0 &&
+             g.regions[idx(g.faces[idx(outside[k])].region)].type == mesh::RegionType::Flat;
     };
     const bool endsLow = (outside.front() < 0 || angle.front() < params.thetaLow) &&
                          (outside.back() < 0 || angle.back() < params.thetaLow);
@@ -286,7 +280,7 @@ void updateJunctions(GeometricMesh& g, const CrumpleParams& params,
       for (const bool front : {true, false}) {
         const std::size_t k = front ? 0 : rulings.size() - 1;
         if (!flatOutside(k) || !(angle[k] > params.thetaHigh)) continue;
-        const int flat = g.faces[static_cast<std::size_t>(outside[k])].region;
+        const int flat = g.faces[idx(outside[k])].region;
         const GeometricMesh before = g;
         bool moved = false;
         try {
@@ -314,14 +308,11 @@ void updateJunctions(GeometricMesh& g, const CrumpleParams& params,
       return static_cast<int>(g.regions.size()) - 1;
     };
     const int frontFlat =
-        first == 0 ? -1
-                   : (flatOutside(0) ? g.faces[static_cast<std::size_t>(outside.front())].region
-                                     : newFlat());
-    const int backFlat = last + 1 == rulings.size()
-                             ? -1
-                             : (flatOutside(rulings.size() - 1)
-                                    ? g.faces[static_cast<std::size_t>(outside.back())].region
-                                    : newFlat());
+        first == 0 ? -1 : (flatOutside(0) ? g.faces[idx(outside.front())].region : newFlat());
+    const int backFlat =
+        last + 1 == rulings.size()
+            ? -1
+            : (flatOutside(rulings.size() - 1) ? g.faces[idx(outside.back())].region : newFlat());
     removeRegionFaces(g, region);
     for (std::size_t k = 0; k < first; ++k) addFlatCell(g, rulings[k], rulings[k + 1], frontFlat);
     for (std::size_t k = last; k + 1 < rulings.size(); ++k)

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 
+#include "crumple/core/index.hpp"
 #include "crumple/mesh/delaunay.hpp"
 
 namespace crumple::paper::detail {
@@ -33,7 +34,7 @@ std::optional<Loop> regionLoop(const GeometricMesh& g, int region, const EdgeMap
       const int a = face.v[k];
       const int b = face.v[(k + 1) % n];
       const int o = otherFace(edges, a, b, static_cast<int>(f));
-      if (o >= 0 && g.faces[static_cast<std::size_t>(o)].region == region) continue;
+      if (o >= 0 && g.faces[idx(o)].region == region) continue;
       if (out.contains(a)) return std::nullopt;  // pinched region
       out[a] = {b, o};
       ++count;
@@ -58,8 +59,8 @@ bool pointInPolygon(const GeometricMesh& g, std::span<const int> polygon, const 
   bool inside = false;
   const std::size_t n = polygon.size();
   for (std::size_t k = 0; k < n; ++k) {
-    const Vec2& a = g.vertices[static_cast<std::size_t>(polygon[k])].pattern;
-    const Vec2& b = g.vertices[static_cast<std::size_t>(polygon[(k + 1) % n])].pattern;
+    const Vec2& a = g.vertices[idx(polygon[k])].pattern;
+    const Vec2& b = g.vertices[idx(polygon[(k + 1) % n])].pattern;
     if ((a.y() > p.y()) != (b.y() > p.y()) &&
         a.x() + (p.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y()) > p.x()) {
       inside = !inside;
@@ -74,13 +75,13 @@ bool insideLoop(const GeometricMesh& g, const Loop& loop, const Vec2& p) {
 
 std::vector<int> innerVertices(const GeometricMesh& g, int region, const Loop& loop) {
   std::vector<char> seen(g.vertices.size(), 0);
-  for (int v : loop.v) seen[static_cast<std::size_t>(v)] = 1;
+  for (int v : loop.v) seen[idx(v)] = 1;
   std::vector<int> out;
   for (const GeometricFace& f : g.faces) {
     if (f.region != region) continue;
     for (int k = 0; k < f.size(); ++k) {
-      if (!seen[static_cast<std::size_t>(f.v[k])]) {
-        seen[static_cast<std::size_t>(f.v[k])] = 1;
+      if (!seen[idx(f.v[k])]) {
+        seen[idx(f.v[k])] = 1;
         out.push_back(f.v[k]);
       }
     }
@@ -115,19 +116,18 @@ void triangulatePolygon(GeometricMesh& g, const std::vector<int>& polygon, int r
   std::vector<int> ids = polygon;
   std::vector<std::array<int, 2>> constraints;
   for (std::size_t k = 0; k < polygon.size(); ++k) {
-    points.push_back(g.vertices[static_cast<std::size_t>(polygon[k])].pattern);
+    points.push_back(g.vertices[idx(polygon[k])].pattern);
     constraints.push_back({static_cast<int>(k), static_cast<int>((k + 1) % polygon.size())});
   }
   for (int v : inner) {
-    const Vec2& p = g.vertices[static_cast<std::size_t>(v)].pattern;
+    const Vec2& p = g.vertices[idx(v)].pattern;
     if (!pointInPolygon(g, polygon, p)) continue;
     points.push_back(p);
     ids.push_back(v);
   }
   for (const auto& t : mesh::constrainedDelaunay(points, constraints)) {
     GeometricFace f;
-    f.v = {ids[static_cast<std::size_t>(t[0])], ids[static_cast<std::size_t>(t[1])],
-           ids[static_cast<std::size_t>(t[2])], -1};
+    f.v = {ids[idx(t[0])], ids[idx(t[1])], ids[idx(t[2])], -1};
     f.region = region;
     g.faces.push_back(f);
   }
@@ -143,8 +143,8 @@ int addRegion(GeometricMesh& g, mesh::RegionType type) {
 // A new vertex on the dS edge (a, b) at pattern point p.
 int addBoundaryVertex(GeometricMesh& g, int a, int b, const Vec2& p,
                       const std::function<Vec3(double)>& boundary) {
-  const GeometricVertex& va = g.vertices[static_cast<std::size_t>(a)];
-  const GeometricVertex& vb = g.vertices[static_cast<std::size_t>(b)];
+  const GeometricVertex& va = g.vertices[idx(a)];
+  const GeometricVertex& vb = g.vertices[idx(b)];
   const double len = (vb.pattern - va.pattern).norm();
   const double u = std::clamp((p - va.pattern).norm() / len, 0.0, 1.0);
   GeometricVertex v;

@@ -9,6 +9,7 @@
 #include <span>
 #include <sstream>
 
+#include "crumple/core/index.hpp"
 #include "crumple/paper/compression.hpp"
 #include "crumple/paper/geometric_step.hpp"
 #include "region_tools.hpp"
@@ -41,10 +42,9 @@ using detail::vertexInCell;
 TriangleCompression faceCompression(const GeometricMesh& g, const GeometricFace& face) {
   std::array<Vec2, 3> pattern;
   std::array<Vec3, 3> position;
-  for (int k = 0; k < 3; ++k) {
-    pattern[static_cast<std::size_t>(k)] = g.vertices[static_cast<std::size_t>(face.v[k])].pattern;
-    position[static_cast<std::size_t>(k)] =
-        g.vertices[static_cast<std::size_t>(face.v[k])].position;
+  for (std::size_t k = 0; k < 3; ++k) {
+    pattern[k] = g.vertices[idx(face.v[k])].pattern;
+    position[k] = g.vertices[idx(face.v[k])].position;
   }
   return analyzeCompression(pattern, position);
 }
@@ -82,9 +82,7 @@ bool splitAlongCrease(GeometricMesh& g, int region, int s1, int s2) {
 // Orients the rulings of a curved region so that every .a lies on the same
 // boundary chain as rulings[0].a.
 std::vector<Ruling> orientedRulings(const GeometricMesh& g, std::vector<Ruling> rulings) {
-  const auto P = [&](int v) -> const Vec2& {
-    return g.vertices[static_cast<std::size_t>(v)].pattern;
-  };
+  const auto P = [&](int v) -> const Vec2& { return g.vertices[idx(v)].pattern; };
   for (std::size_t k = 1; k < rulings.size(); ++k) {
     const Vec2 a0 = P(rulings[k - 1].a);
     if (rulings[k].a != rulings[k - 1].a && rulings[k].b != rulings[k - 1].b &&
@@ -113,7 +111,7 @@ void treatCurvedCompression(GeometricMesh& g, const CrumpleParams& params, const
   const std::size_t faceCount = g.faces.size();
   std::vector<char> settled(regionCount, 1);
   for (std::size_t f = 0; f < faceCount && mayRemesh; ++f) {
-    if (!mayRemesh(static_cast<int>(f))) settled[static_cast<std::size_t>(g.faces[f].region)] = 0;
+    if (!mayRemesh(static_cast<int>(f))) settled[idx(g.faces[f].region)] = 0;
   }
   for (std::size_t r = 0; r < regionCount; ++r) {
     if (g.regions[r].type != mesh::RegionType::Curved || g.regions[r].apex >= 0) continue;
@@ -121,12 +119,8 @@ void treatCurvedCompression(GeometricMesh& g, const CrumpleParams& params, const
     if (stats.singularInserted >= params.maxSingularPerFrame) break;
     if (g.regions[r].rulings.size() < 2) continue;
     const std::vector<Ruling> rulings = orientedRulings(g, g.regions[r].rulings);
-    const auto P = [&](int v) -> const Vec2& {
-      return g.vertices[static_cast<std::size_t>(v)].pattern;
-    };
-    const auto X = [&](int v) -> const Vec3& {
-      return g.vertices[static_cast<std::size_t>(v)].position;
-    };
+    const auto P = [&](int v) -> const Vec2& { return g.vertices[idx(v)].pattern; };
+    const auto X = [&](int v) -> const Vec3& { return g.vertices[idx(v)].position; };
     // The most compressed ruling with both ends on dS (interior rulings only:
     // the end rulings are borders with other regions).
     std::size_t kmax = 0;
@@ -197,8 +191,8 @@ void treatCurvedCompression(GeometricMesh& g, const CrumpleParams& params, const
       if (g.regions[r].rulings.size() >= 2) rebuildCurvedFaces(g, cr);
       if (lo >= 1) {
         const int back = addRegion(g, mesh::RegionType::Curved);
-        g.regions[static_cast<std::size_t>(back)].rulings.assign(
-            rulings.begin(), rulings.begin() + static_cast<std::ptrdiff_t>(lo) + 1);
+        g.regions[idx(back)].rulings.assign(rulings.begin(),
+                                            rulings.begin() + static_cast<std::ptrdiff_t>(lo) + 1);
         rebuildCurvedFaces(g, back);
       }
       // Fans from s to both chains between r_lo and r_hi.
@@ -247,16 +241,14 @@ std::optional<std::pair<Vec2, Vec2>> bendingDirection(const GeometricMesh& g, in
   double most = 0.5 * theta0;
   Vec2 origin = Vec2::Zero();
   const auto normal = [&](int t) {
-    const auto& tri = sp.triangles[static_cast<std::size_t>(t)];
-    const Vec3& a = sp.positions[static_cast<std::size_t>(tri[0])];
-    return Vec3((sp.positions[static_cast<std::size_t>(tri[1])] - a)
-                    .cross(sp.positions[static_cast<std::size_t>(tri[2])] - a)
-                    .normalized());
+    const auto& tri = sp.triangles[idx(t)];
+    const Vec3& a = sp.positions[idx(tri[0])];
+    return Vec3((sp.positions[idx(tri[1])] - a).cross(sp.positions[idx(tri[2])] - a).normalized());
   };
   for (const mesh::MeshEdge& e : edges) {
     if (!e.interior()) continue;
-    const Vec2& pa = sp.pattern[static_cast<std::size_t>(e.v[0])];
-    const Vec2& pb = sp.pattern[static_cast<std::size_t>(e.v[1])];
+    const Vec2& pa = sp.pattern[idx(e.v[0])];
+    const Vec2& pb = sp.pattern[idx(e.v[1])];
     const Vec2 mid = 0.5 * (pa + pb);
     bool inside = false;
     for (const GeometricFace& f : g.faces) {
@@ -300,8 +292,8 @@ int bendFoldedFlatRegions(GeometricMesh& g, const CrumpleParams& params,
     std::pair<int, int> fold{-1, -1};
     for (const auto& [key, faces] : edges) {
       if (faces[0] < 0 || faces[1] < 0) continue;
-      if (g.faces[static_cast<std::size_t>(faces[0])].region != static_cast<int>(r) ||
-          g.faces[static_cast<std::size_t>(faces[1])].region != static_cast<int>(r)) {
+      if (g.faces[idx(faces[0])].region != static_cast<int>(r) ||
+          g.faces[idx(faces[1])].region != static_cast<int>(r)) {
         continue;
       }
       const double angle = dihedralAngle(g, faces[0], faces[1]);
@@ -311,8 +303,8 @@ int bendFoldedFlatRegions(GeometricMesh& g, const CrumpleParams& params,
       }
     }
     if (fold.first < 0) continue;
-    const Vec2 a = g.vertices[static_cast<std::size_t>(fold.first)].pattern;
-    const Vec2 b = g.vertices[static_cast<std::size_t>(fold.second)].pattern;
+    const Vec2 a = g.vertices[idx(fold.first)].pattern;
+    const Vec2 b = g.vertices[idx(fold.second)].pattern;
     // Candidate pencils, most faithful first: how S_P bends (through its
     // most bent hinge, then through the fold), the folded S_G edge, and the
     // directions of the rulings bounding the region (a flat gap between two
@@ -332,11 +324,9 @@ int bendFoldedFlatRegions(GeometricMesh& g, const CrumpleParams& params,
       for (std::size_t k = 0; k < loop->size(); ++k) {
         const int across = loop->across[k];
         if (across < 0 ||
-            g.regions[static_cast<std::size_t>(g.faces[static_cast<std::size_t>(across)].region)]
-                    .type != mesh::RegionType::Curved)
+            g.regions[idx(g.faces[idx(across)].region)].type != mesh::RegionType::Curved)
           continue;
-        const Vec2 d = g.vertices[static_cast<std::size_t>(loop->next(k))].pattern -
-                       g.vertices[static_cast<std::size_t>(loop->v[k])].pattern;
+        const Vec2 d = g.vertices[idx(loop->next(k))].pattern - g.vertices[idx(loop->v[k])].pattern;
         if (d.norm() > 0.0) candidates.push_back({-1, foldMid, d.normalized()});
       }
     }
@@ -390,11 +380,10 @@ std::vector<std::pair<double, std::size_t>> regionsByCompression(const Geometric
   std::vector<std::pair<double, std::size_t>> order;
   std::vector<double> worst(regionCount, 0.0);
   for (const GeometricFace& face : g.faces) {
-    if (face.size() != 3 ||
-        g.regions[static_cast<std::size_t>(face.region)].type != mesh::RegionType::Flat) {
+    if (face.size() != 3 || g.regions[idx(face.region)].type != mesh::RegionType::Flat) {
       continue;
     }
-    double& w = worst[static_cast<std::size_t>(face.region)];
+    double& w = worst[idx(face.region)];
     w = std::max(w, faceCompression(g, face).ratio());
   }
   for (std::size_t r = 0; r < regionCount; ++r) order.emplace_back(-worst[r], r);
@@ -429,24 +418,23 @@ bool existingApices(const GeometricMesh& g, const detail::Loop& loop,
       // A border edge ending at a singular vertex (e.g. a crease between
       // two): the rulings are attracted by that existing d-cone apex
       // (Appendix B, Fig. 24 b) instead of a new one beside it.
-      const int ea = loop.v[static_cast<std::size_t>(b.loopEdge)];
-      const int eb = loop.next(static_cast<std::size_t>(b.loopEdge));
-      const bool sa = g.vertices[static_cast<std::size_t>(ea)].singular;
-      const bool sb = g.vertices[static_cast<std::size_t>(eb)].singular;
+      const int ea = loop.v[idx(b.loopEdge)];
+      const int eb = loop.next(idx(b.loopEdge));
+      const bool sa = g.vertices[idx(ea)].singular;
+      const bool sb = g.vertices[idx(eb)].singular;
       if (sa || sb) {
-        const double da = (g.vertices[static_cast<std::size_t>(ea)].pattern - b.hit).norm();
-        const double db = (g.vertices[static_cast<std::size_t>(eb)].pattern - b.hit).norm();
+        const double da = (g.vertices[idx(ea)].pattern - b.hit).norm();
+        const double db = (g.vertices[idx(eb)].pattern - b.hit).norm();
         existingApex[side] = sa && (!sb || da <= db) ? ea : eb;
       }
       continue;
     }
     if (b.kind != Border::Kind::Curved) continue;
-    const int across = loop.across[static_cast<std::size_t>(b.loopEdge)];
-    const int apex =
-        g.regions[static_cast<std::size_t>(g.faces[static_cast<std::size_t>(across)].region)].apex;
+    const int across = loop.across[idx(b.loopEdge)];
+    const int apex = g.regions[idx(g.faces[idx(across)].region)].apex;
     if (apex < 0) continue;
-    const int ea = loop.v[static_cast<std::size_t>(b.loopEdge)];
-    const int eb = loop.next(static_cast<std::size_t>(b.loopEdge));
+    const int ea = loop.v[idx(b.loopEdge)];
+    const int eb = loop.next(idx(b.loopEdge));
     if (apex == ea || apex == eb) {
       existingApex[side] = apex;
     } else {
@@ -501,7 +489,7 @@ StripResult remeshCompressedStrip(CompressionStep& step, std::size_t r, const Ve
   const auto coneFrom = [&](int apex, int side) {
     Pencil pencil;
     pencil.apex = apex;
-    const Vec2 s = g.vertices[static_cast<std::size_t>(apex)].pattern;
+    const Vec2 s = g.vertices[idx(apex)].pattern;
     pencil.origin = s;
     StripResult out{false, "no pencil"};
     for (const Vec2& target : {borders[1 - side]->hit, centroid}) {
@@ -547,8 +535,8 @@ void recordStrip(const GeometricMesh& g, const Vec2& centroid, const int (&singu
     stats.notes.push_back(why.str());
   }
   for (int sv : singular) {
-    if (sv >= 0 && static_cast<std::size_t>(sv) < g.vertices.size()) {
-      stats.cuts.push_back(g.vertices[static_cast<std::size_t>(sv)].pattern);
+    if (inRange(g.vertices, sv)) {
+      stats.cuts.push_back(g.vertices[idx(sv)].pattern);
     }
   }
 }
@@ -566,15 +554,14 @@ bool treatCompressedRegion(CompressionStep& step, std::size_t r) {
   if (tcomp < 0) return false;
   stats.maxCompression = std::max(stats.maxCompression, best.ratio());
   if (!(best.ratio() > params.epsC)) return false;
-  const GeometricFace tri = g.faces[static_cast<std::size_t>(tcomp)];
+  const GeometricFace tri = g.faces[idx(tcomp)];
   Vec2 centroid = Vec2::Zero();
-  for (int k = 0; k < 3; ++k)
-    centroid += g.vertices[static_cast<std::size_t>(tri.v[k])].pattern / 3.0;
+  for (int k = 0; k < 3; ++k) centroid += g.vertices[idx(tri.v[k])].pattern / 3.0;
   // Each remeshing is a transaction: S_G is checked afterwards and
   // restored (the region declined for this step) when it would break an
   // invariant, so one bad case cannot corrupt the sheet.
   const GeometricMesh before = g;
-  const std::size_t singularBefore = static_cast<std::size_t>(stats.singularInserted);
+  const std::size_t singularBefore = idx(stats.singularInserted);
   const auto rollback = [&](const std::string& why) {
     g = before;
     stats.singularInserted = static_cast<int>(singularBefore);
@@ -668,7 +655,7 @@ void treatCompression(GeometricMesh& g, const CrumpleParams& params,
   // Regions holding a face that may not be remeshed yet wait (cooldown).
   std::vector<char> declined(g.regions.size(), 0);
   for (std::size_t f = 0; f < g.faces.size() && mayRemesh; ++f) {
-    if (!mayRemesh(static_cast<int>(f))) declined[static_cast<std::size_t>(g.faces[f].region)] = 1;
+    if (!mayRemesh(static_cast<int>(f))) declined[idx(g.faces[f].region)] = 1;
   }
   CompressionStep step{g, params, boundary, rng, drawIndex, stats, edgeCache, declined};
   // Regions are processed in id order, once per step: regions created here

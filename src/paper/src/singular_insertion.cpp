@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "crumple/core/geometry2d.hpp"
+#include "crumple/core/index.hpp"
 
 namespace crumple::paper::detail {
 
@@ -16,8 +17,8 @@ namespace {
 // Splits the interior edge (a, b) at pattern point p with a new singular
 // vertex, splitting both incident triangles (paper Sec. 5.2, flat-flat case).
 int insertSingularOnEdge(GeometricMesh& g, int a, int b, const Vec2& p) {
-  const GeometricVertex& va = g.vertices[static_cast<std::size_t>(a)];
-  const GeometricVertex& vb = g.vertices[static_cast<std::size_t>(b)];
+  const GeometricVertex& va = g.vertices[idx(a)];
+  const GeometricVertex& vb = g.vertices[idx(b)];
   const double u = std::clamp(
       (p - va.pattern).dot(vb.pattern - va.pattern) / (vb.pattern - va.pattern).squaredNorm(), 0.0,
       1.0);
@@ -54,9 +55,7 @@ int insertSingularOnEdge(GeometricMesh& g, int a, int b, const Vec2& p) {
 // s lies in neither triangle.
 std::optional<GeometricVertex> vertexInCell(const GeometricMesh& g, const Ruling& r0,
                                             const Ruling& r1, const Vec2& s) {
-  const auto P = [&](int v) -> const Vec2& {
-    return g.vertices[static_cast<std::size_t>(v)].pattern;
-  };
+  const auto P = [&](int v) -> const Vec2& { return g.vertices[idx(v)].pattern; };
   const std::array<int, 4> q{r0.a, r1.a, r1.b, r0.b};
   for (const auto& tri :
        {std::array<int, 3>{q[0], q[1], q[2]}, std::array<int, 3>{q[0], q[2], q[3]}}) {
@@ -70,12 +69,10 @@ std::optional<GeometricVertex> vertexInCell(const GeometricMesh& g, const Ruling
     const auto& V = g.vertices;
     GeometricVertex v;
     v.pattern = s;
-    v.position = l0 * V[static_cast<std::size_t>(tri[0])].position +
-                 l1 * V[static_cast<std::size_t>(tri[1])].position +
-                 l2 * V[static_cast<std::size_t>(tri[2])].position;
-    v.velocity = l0 * V[static_cast<std::size_t>(tri[0])].velocity +
-                 l1 * V[static_cast<std::size_t>(tri[1])].velocity +
-                 l2 * V[static_cast<std::size_t>(tri[2])].velocity;
+    v.position =
+        l0 * V[idx(tri[0])].position + l1 * V[idx(tri[1])].position + l2 * V[idx(tri[2])].position;
+    v.velocity =
+        l0 * V[idx(tri[0])].velocity + l1 * V[idx(tri[1])].velocity + l2 * V[idx(tri[2])].velocity;
     return v;
   }
   return std::nullopt;
@@ -95,17 +92,15 @@ void addConeFans(GeometricMesh& g, int s, const std::vector<Ruling>& rulings, st
     }
     if (fan.size() < 2) continue;
     const int fr = addRegion(g, mesh::RegionType::Curved);
-    g.regions[static_cast<std::size_t>(fr)].rulings = fan;
-    g.regions[static_cast<std::size_t>(fr)].apex = s;
+    g.regions[idx(fr)].rulings = fan;
+    g.regions[idx(fr)].apex = s;
     rebuildCurvedFaces(g, fr);
   }
 }
 
 // Appends the triangle (a, b, c), counter-clockwise in the pattern, to `region`.
 void addTriangleCCW(GeometricMesh& g, int a, int b, int c, int region) {
-  const auto P = [&](int v) -> const Vec2& {
-    return g.vertices[static_cast<std::size_t>(v)].pattern;
-  };
+  const auto P = [&](int v) -> const Vec2& { return g.vertices[idx(v)].pattern; };
   GeometricFace f;
   f.v = {a, b, c, -1};
   if (cross2(P(b) - P(a), P(c) - P(a)) < 0.0) std::swap(f.v[1], f.v[2]);
@@ -136,10 +131,10 @@ bool crowded(const GeometricMesh& g, const Vec2& p, const CrumpleParams& params)
 int placeSingularOnBorder(GeometricMesh& g, const Loop& loop, const Border& border,
                           const CrumpleParams& params, const CounterRng& rng,
                           std::uint64_t& drawIndex) {
-  const int a = loop.v[static_cast<std::size_t>(border.loopEdge)];
-  const int b = loop.next(static_cast<std::size_t>(border.loopEdge));
-  const Vec2& pa = g.vertices[static_cast<std::size_t>(a)].pattern;
-  const Vec2& pb = g.vertices[static_cast<std::size_t>(b)].pattern;
+  const int a = loop.v[idx(border.loopEdge)];
+  const int b = loop.next(idx(border.loopEdge));
+  const Vec2& pa = g.vertices[idx(a)].pattern;
+  const Vec2& pb = g.vertices[idx(b)].pattern;
   const double len = (pb - pa).norm();
   const double u0 = (border.hit - pa).norm() / len;
   const double shift = normalDeviate(rng, drawIndex) * params.sigma / std::sqrt(2.0);
@@ -160,11 +155,11 @@ int placeSingularOnBorder(GeometricMesh& g, const Loop& loop, const Border& bord
 int insertSingularInCurved(GeometricMesh& g, int flat, const Loop& loop, const Border& border,
                            const CrumpleParams& params, const CounterRng& rng,
                            std::uint64_t& drawIndex) {
-  const int ea = loop.v[static_cast<std::size_t>(border.loopEdge)];
-  const int eb = loop.next(static_cast<std::size_t>(border.loopEdge));
-  const int across = loop.across[static_cast<std::size_t>(border.loopEdge)];
-  const int cr = g.faces[static_cast<std::size_t>(across)].region;
-  Region& curved = g.regions[static_cast<std::size_t>(cr)];
+  const int ea = loop.v[idx(border.loopEdge)];
+  const int eb = loop.next(idx(border.loopEdge));
+  const int across = loop.across[idx(border.loopEdge)];
+  const int cr = g.faces[idx(across)].region;
+  Region& curved = g.regions[idx(cr)];
   if (curved.apex >= 0 || curved.rulings.size() < 2) return -1;
   std::vector<Ruling> rulings = curved.rulings;
   const auto same = [](const Ruling& r, int x, int y) {
@@ -175,9 +170,9 @@ int insertSingularInCurved(GeometricMesh& g, int flat, const Loop& loop, const B
   const std::size_t n = rulings.size() - 1;       // cells 0..n-1
   // Orient every ruling so .a is on the same chain as rulings[0].a.
   for (std::size_t k = 1; k <= n; ++k) {
-    const Vec2 a0 = g.vertices[static_cast<std::size_t>(rulings[k - 1].a)].pattern;
-    const Vec2 pa = g.vertices[static_cast<std::size_t>(rulings[k].a)].pattern;
-    const Vec2 pb = g.vertices[static_cast<std::size_t>(rulings[k].b)].pattern;
+    const Vec2 a0 = g.vertices[idx(rulings[k - 1].a)].pattern;
+    const Vec2 pa = g.vertices[idx(rulings[k].a)].pattern;
+    const Vec2 pb = g.vertices[idx(rulings[k].b)].pattern;
     if ((pb - a0).norm() < (pa - a0).norm() && rulings[k].a != rulings[k - 1].a)
       std::swap(rulings[k].a, rulings[k].b);
   }
@@ -194,9 +189,7 @@ int insertSingularInCurved(GeometricMesh& g, int flat, const Loop& loop, const B
       break;
     }
   }
-  const auto P = [&](int v) -> const Vec2& {
-    return g.vertices[static_cast<std::size_t>(v)].pattern;
-  };
+  const auto P = [&](int v) -> const Vec2& { return g.vertices[idx(v)].pattern; };
   // Draw s: uniform along e_sing (kept off its ends), normal across it.
   const Vec2 sa = P(rulings[ksing].a);
   const Vec2 sb = P(rulings[ksing].b);
@@ -255,7 +248,7 @@ int insertSingularInCurved(GeometricMesh& g, int flat, const Loop& loop, const B
   // Rebuild: C keeps rulings sup..n; fans from s on both chains; transition
   // triangle (s, a_sup, b_sup) flat; triangle (s, a_0, b_0) joins F.
   removeRegionFaces(g, cr);
-  Region& c2 = g.regions[static_cast<std::size_t>(cr)];
+  Region& c2 = g.regions[idx(cr)];
   c2.rulings.assign(rulings.begin() + static_cast<std::ptrdiff_t>(sup), rulings.end());
   if (c2.rulings.size() >= 2) rebuildCurvedFaces(g, cr);
   addConeFans(g, sIndex, rulings, 0, sup);

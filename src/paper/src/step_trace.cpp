@@ -6,6 +6,7 @@
 #include <string>
 
 #include "crumple/core/debug.hpp"
+#include "crumple/core/index.hpp"
 
 namespace crumple::paper::detail {
 
@@ -42,9 +43,9 @@ void printStepTrace(int level, int frame, const GeometricMesh& sg, const Physica
   double quality = 1.0;
   std::array<int, 3> worst{0, 0, 0};
   for (const auto& tri : sp.mesh.triangles) {
-    const Vec2& a = sp.mesh.pattern[static_cast<std::size_t>(tri[0])];
-    const Vec2& b = sp.mesh.pattern[static_cast<std::size_t>(tri[1])];
-    const Vec2& c = sp.mesh.pattern[static_cast<std::size_t>(tri[2])];
+    const Vec2& a = sp.mesh.pattern[idx(tri[0])];
+    const Vec2& b = sp.mesh.pattern[idx(tri[1])];
+    const Vec2& c = sp.mesh.pattern[idx(tri[2])];
     const Vec2 ab = b - a;
     const Vec2 ac = c - a;
     const double area = 0.5 * (ab.x() * ac.y() - ab.y() * ac.x());
@@ -61,8 +62,7 @@ void printStepTrace(int level, int frame, const GeometricMesh& sg, const Physica
     if (a > maxHinge) {
       maxHinge = a;
       const auto& e = elastic.hinges()[h];
-      maxHingeAt = 0.5 * (sp.mesh.pattern[static_cast<std::size_t>(e.v[0])] +
-                          sp.mesh.pattern[static_cast<std::size_t>(e.v[1])]);
+      maxHingeAt = 0.5 * (sp.mesh.pattern[idx(e.v[0])] + sp.mesh.pattern[idx(e.v[1])]);
     }
   }
   std::fprintf(
@@ -76,9 +76,8 @@ void printStepTrace(int level, int frame, const GeometricMesh& sg, const Physica
       stats.elastic.halvings, maxHinge, 100 * maxHingeAt.x(), 100 * maxHingeAt.y(), hinge[0],
       hinge[1], hinge[2], quality);
   for (int k : worst) {
-    const Vec2& p = sp.mesh.pattern[static_cast<std::size_t>(k)];
-    std::fprintf(stderr, " %d%s(%.2f, %.2f cm)", k,
-                 static_cast<std::size_t>(k) < sg.vertices.size() ? "g" : "", 100 * p.x(),
+    const Vec2& p = sp.mesh.pattern[idx(k)];
+    std::fprintf(stderr, " %d%s(%.2f, %.2f cm)", k, inRange(sg.vertices, k) ? "g" : "", 100 * p.x(),
                  100 * p.y());
   }
   // Max edge strain as the elastic step left S_P, and the strain limit's
@@ -90,11 +89,11 @@ void printStepTrace(int level, int frame, const GeometricMesh& sg, const Physica
   std::fprintf(stderr, "\n");
   if (level == 3) {  // the worst edges at the step's end (isometry, strain limit, contacts)
     std::vector<char> isPinned(sp.mesh.vertexCount(), 0);
-    for (const auto& p : pinned) isPinned[static_cast<std::size_t>(p.vertex)] = 1;
+    for (const auto& p : pinned) isPinned[idx(p.vertex)] = 1;
     std::vector<std::pair<double, std::array<int, 2>>> errs;
     for (const auto& e : mesh::buildEdges(sp.mesh)) {
-      const auto a = static_cast<std::size_t>(e.v[0]);
-      const auto b = static_cast<std::size_t>(e.v[1]);
+      const auto a = idx(e.v[0]);
+      const auto b = idx(e.v[1]);
       const double l0 = (sp.mesh.pattern[a] - sp.mesh.pattern[b]).norm();
       const double l = (sp.mesh.positions[a] - sp.mesh.positions[b]).norm();
       errs.push_back({(l - l0) / l0, e.v});
@@ -104,10 +103,9 @@ void printStepTrace(int level, int frame, const GeometricMesh& sg, const Physica
     for (std::size_t k = 0; k < std::min<std::size_t>(8, errs.size()); ++k) {
       std::fprintf(stderr, "[geometry]   edge err %+.4f:", errs[k].first);
       for (int v : errs[k].second) {
-        const Vec2& p = sp.mesh.pattern[static_cast<std::size_t>(v)];
-        std::fprintf(stderr, " %d%s%s(%.2f, %.2f cm)", v,
-                     static_cast<std::size_t>(v) < sg.vertices.size() ? "g" : "",
-                     isPinned[static_cast<std::size_t>(v)] ? "P" : "", 100 * p.x(), 100 * p.y());
+        const Vec2& p = sp.mesh.pattern[idx(v)];
+        std::fprintf(stderr, " %d%s%s(%.2f, %.2f cm)", v, inRange(sg.vertices, v) ? "g" : "",
+                     isPinned[idx(v)] ? "P" : "", 100 * p.x(), 100 * p.y());
       }
       std::fprintf(stderr, "\n");
     }
@@ -124,9 +122,7 @@ void printStepTrace(int level, int frame, const GeometricMesh& sg, const Physica
       const GeometricFace& gf = sg.faces[f];
       std::fprintf(stderr, "[geometry]   f %zu: %d %d %d %d region %d %s\n", f, gf.v[0], gf.v[1],
                    gf.v[2], gf.v[3], gf.region,
-                   sg.regions[static_cast<std::size_t>(gf.region)].type == mesh::RegionType::Curved
-                       ? "curved"
-                       : "flat");
+                   sg.regions[idx(gf.region)].type == mesh::RegionType::Curved ? "curved" : "flat");
     }
   }
   for (const std::string& note : gs.notes) std::fprintf(stderr, "[geometry]   %s\n", note.c_str());
@@ -139,7 +135,7 @@ void dumpFailedStep(const mesh::SheetMesh& mm, std::size_t geometricCount) {
   if (f == nullptr) return;
   std::vector<int> uses(mm.vertexCount(), 0);
   for (const auto& t : mm.triangles)
-    for (int k : t) ++uses[static_cast<std::size_t>(k)];
+    for (int k : t) ++uses[idx(k)];
   for (std::size_t i = 0; i < mm.vertexCount(); ++i)
     std::fprintf(f, "v %.9g %.9g %.9g\n# uses %d pattern %.9g %.9g sg %d\n", mm.positions[i].x(),
                  mm.positions[i].y(), mm.positions[i].z(), uses[i], mm.pattern[i].x(),

@@ -13,15 +13,10 @@
 #include <tuple>
 #include <utility>
 
+#include "crumple/core/index.hpp"
 #include "crumple/core/work_budget.hpp"
 
 namespace crumple::paper {
-
-namespace {
-
-std::size_t at(int i) { return static_cast<std::size_t>(i); }
-
-}  // namespace
 
 LengthProjector::LengthProjector(const std::vector<Vec2>& pattern,
                                  const std::vector<std::array<int, 3>>& triangles)
@@ -29,12 +24,12 @@ LengthProjector::LengthProjector(const std::vector<Vec2>& pattern,
   std::map<std::pair<int, int>, int> seen;
   std::vector<char> used(pattern.size(), 0);
   for (const auto& t : triangles)
-    for (int k = 0; k < 3; ++k) {
-      const int a = t[at(k)], b = t[at((k + 1) % 3)];
-      used[at(a)] = 1;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      used[idx(a)] = 1;
       const auto key = std::make_pair(std::min(a, b), std::max(a, b));
       if (!seen.emplace(key, 0).second) continue;
-      const double rest = (pattern[at(a)] - pattern[at(b)]).norm();
+      const double rest = (pattern[idx(a)] - pattern[idx(b)]).norm();
       if (!(rest > 0.0)) continue;  // a degenerate pattern edge has no strain
       edges_.push_back({key.first, key.second});
       rest_.push_back(rest);
@@ -56,7 +51,7 @@ std::size_t LengthProjector::crossings(const std::vector<Vec3>& x) const {
 std::pair<double, double> LengthProjector::strain(const std::vector<Vec3>& x) const {
   double mx = 0.0, sum = 0.0;
   for (std::size_t k = 0; k < edges_.size(); ++k) {
-    const double l = (x[at(edges_[k][1])] - x[at(edges_[k][0])]).norm();
+    const double l = (x[idx(edges_[k][1])] - x[idx(edges_[k][0])]).norm();
     const double r = std::abs(l - rest_[k]) / rest_[k];
     mx = std::max(mx, r);
     sum += r;
@@ -116,7 +111,7 @@ class LengthObjective {
       s += r * r + (weight(r) - 1.0) * (std::abs(r) - soft_) * (std::abs(r) - soft_);
     }
     for (std::size_t h = 0; h < handles_.size(); ++h)
-      s += handleWeight_ * (p[at(handles_[h])] - targets_[h]).squaredNorm();
+      s += handleWeight_ * (p[idx(handles_[h])] - targets_[h]).squaredNorm();
     return s;
   }
 
@@ -128,7 +123,7 @@ class LengthObjective {
     g.setZero();
     for (std::size_t k = 0; k < edges_.size(); ++k) {
       const auto [a, b] = edges_[k];
-      const Vec3 d = x[at(b)] - x[at(a)];
+      const Vec3 d = x[idx(b)] - x[idx(a)];
       const double l = d.norm();
       const double r = (l - rest_[k]) / rest_[k];
       const double w = weight(r);
@@ -139,28 +134,27 @@ class LengthObjective {
       // A collapsed edge has no direction; its zero block keeps the sparsity
       // pattern the symbolic analysis was made for.
       const Vec3 u = l > 0.0 ? Vec3(d / (l * rest_[k])) : Vec3::Zero();
-      const std::array<int, 2> cols{column_[at(a)], column_[at(b)]};
+      const std::array<int, 2> cols{column_[idx(a)], column_[idx(b)]};
       const std::array<double, 2> sign{-1.0, 1.0};
-      for (int i = 0; i < 2; ++i) {
-        if (cols[at(i)] < 0) continue;
-        g.segment<3>(3 * cols[at(i)]) += sign[at(i)] * gr * u;
-        for (int j = 0; j < 2; ++j) {
-          if (cols[at(j)] < 0) continue;
-          add(3 * cols[at(i)], 3 * cols[at(j)],
-              wModel * sign[at(i)] * sign[at(j)] * u * u.transpose());
+      for (std::size_t i = 0; i < 2; ++i) {
+        if (cols[i] < 0) continue;
+        g.segment<3>(3 * cols[i]) += sign[i] * gr * u;
+        for (std::size_t j = 0; j < 2; ++j) {
+          if (cols[j] < 0) continue;
+          add(3 * cols[i], 3 * cols[j], wModel * sign[i] * sign[j] * u * u.transpose());
         }
       }
     }
     // The diagonal always in the pattern, so one symbolic analysis serves.
     for (Eigen::Index i = 0; i < n; ++i) triplets_.emplace_back(i, i, 0.0);
     for (std::size_t h = 0; h < handles_.size(); ++h) {
-      const int c = column_[at(handles_[h])];
+      const int c = column_[idx(handles_[h])];
       if (c < 0) continue;
-      g.segment<3>(3 * c) += handleWeight_ * (x[at(handles_[h])] - targets_[h]);
+      g.segment<3>(3 * c) += handleWeight_ * (x[idx(handles_[h])] - targets_[h]);
       add(3 * c, 3 * c, handleWeight_ * Mat3::Identity());
     }
     for (const KeepOut& k : keepOut_) {
-      const int c = k.vertex >= 0 && at(k.vertex) < vertexCount_ ? column_[at(k.vertex)] : -1;
+      const int c = k.vertex >= 0 && idx(k.vertex) < vertexCount_ ? column_[idx(k.vertex)] : -1;
       const double s = c < 0 ? 0.0 : inside(k, x);
       if (s == 0.0) continue;
       g.segment<3>(3 * c) += keepWeight_ * s * k.normal;
@@ -192,14 +186,14 @@ class LengthObjective {
 
  private:
   double residual(const std::vector<Vec3>& p, std::size_t k) const {
-    return ((p[at(edges_[k][1])] - p[at(edges_[k][0])]).norm() - rest_[k]) / rest_[k];
+    return ((p[idx(edges_[k][1])] - p[idx(edges_[k][0])]).norm() - rest_[k]) / rest_[k];
   }
   // An edge's residual weight: over the soft bound it costs kBoundWeight more.
   double weight(double r) const {
     return bound_ > 0.0 && std::abs(r) > soft_ ? 1.0 + LengthProjector::kBoundWeight : 1.0;
   }
   static double inside(const KeepOut& k, const std::vector<Vec3>& p) {
-    return std::min(0.0, k.normal.dot(p[at(k.vertex)] - k.point));
+    return std::min(0.0, k.normal.dot(p[idx(k.vertex)] - k.point));
   }
   void add(Eigen::Index row, Eigen::Index col, const Mat3& block) {
     for (int p = 0; p < 3; ++p)
@@ -239,7 +233,7 @@ LengthProjectionStats LengthProjector::solve(std::vector<Vec3>& x, const std::ve
   std::vector<int> column(vertexCount_, -1);
   int free = 0;
   for (int v : used_)
-    if (at(v) >= held.size() || held[at(v)] == 0) column[at(v)] = free++;
+    if (!inRange(held, v) || held[idx(v)] == 0) column[idx(v)] = free++;
   if (free == 0) return stats;
   LengthObjective objective(edges_, rest_, keepOut_, vertexCount_, column, handles, targets, bound);
   const Eigen::Index n = 3 * static_cast<Eigen::Index>(free);
@@ -278,7 +272,7 @@ LengthProjectionStats LengthProjector::solve(std::vector<Vec3>& x, const std::ve
       }
       std::vector<Vec3> trial = x;
       for (int v : used_)
-        if (const int c = column[at(v)]; c >= 0) trial[at(v)] += step.segment<3>(3 * c);
+        if (const int c = column[idx(v)]; c >= 0) trial[idx(v)] += step.segment<3>(3 * c);
       const double ft = objective.cost(trial);
       const std::size_t trialCrossed = ft < f ? crossings(trial) : crossed;
       if (ft < f && trialCrossed <= crossed) {
@@ -316,14 +310,14 @@ void LengthProjector::holdAwayFrom(const std::vector<Vec3>& x, double above, int
                                    std::vector<char>& held) const {
   std::vector<char> near(vertexCount_, 0);
   for (std::size_t k = 0; k < edges_.size(); ++k) {
-    const double l = (x[at(edges_[k][1])] - x[at(edges_[k][0])]).norm();
+    const double l = (x[idx(edges_[k][1])] - x[idx(edges_[k][0])]).norm();
     if (std::abs(l - rest_[k]) > above * rest_[k])
-      near[at(edges_[k][0])] = near[at(edges_[k][1])] = 1;
+      near[idx(edges_[k][0])] = near[idx(edges_[k][1])] = 1;
   }
   for (int ring = 0; ring < rings; ++ring) {
     std::vector<char> grown = near;
     for (const auto& e : edges_)
-      if (near[at(e[0])] != 0 || near[at(e[1])] != 0) grown[at(e[0])] = grown[at(e[1])] = 1;
+      if (near[idx(e[0])] != 0 || near[idx(e[1])] != 0) grown[idx(e[0])] = grown[idx(e[1])] = 1;
     near = std::move(grown);
   }
   held.resize(vertexCount_, 0);
@@ -376,7 +370,7 @@ std::vector<Vec3> transferByPattern(const std::vector<Vec2>& oldPattern,
     double best = std::numeric_limits<double>::infinity();
     Vec3 placed = Vec3::Zero();
     for (const auto& t : oldTriangles) {
-      const Vec2 &a = oldPattern[at(t[0])], &b = oldPattern[at(t[1])], &c = oldPattern[at(t[2])];
+      const Vec2 &a = oldPattern[idx(t[0])], &b = oldPattern[idx(t[1])], &c = oldPattern[idx(t[2])];
       const Mat2 e = (Mat2() << b - a, c - a).finished();
       const double det = e.determinant();
       if (std::abs(det) < 1e-300) continue;
@@ -389,8 +383,8 @@ std::vector<Vec3> transferByPattern(const std::vector<Vec2>& oldPattern,
       // Clamped barycentrics so a point just outside stays on the triangle.
       Eigen::Vector3d w(std::max(0.0, w0), std::max(0.0, uv.x()), std::max(0.0, uv.y()));
       w /= std::max(1e-300, w.sum());
-      placed = w(0) * oldPositions[at(t[0])] + w(1) * oldPositions[at(t[1])] +
-               w(2) * oldPositions[at(t[2])];
+      placed = w(0) * oldPositions[idx(t[0])] + w(1) * oldPositions[idx(t[1])] +
+               w(2) * oldPositions[idx(t[2])];
       if (outside == 0.0) break;
     }
     out[i] = placed;
@@ -415,7 +409,7 @@ constexpr int kTowardsIterations = 20;
 
 void placeHandles(std::vector<Vec3>& x, const std::vector<int>& handles,
                   const std::vector<Vec3>& where) {
-  for (std::size_t h = 0; h < handles.size(); ++h) x[at(handles[h])] = where[h];
+  for (std::size_t h = 0; h < handles.size(); ++h) x[idx(handles[h])] = where[h];
 }
 
 }  // namespace
@@ -449,7 +443,7 @@ StrainLimitStats limitStrainOnce(const StrainLimitInput& in, std::vector<Vec3>& 
     std::tie(s.maxAfter, s.meanAfter) = projector.strain(x);
     s.handleLags.clear();
     for (std::size_t h = 0; h < in.handles.size(); ++h) {
-      const double d = (x[at(in.handles[h])] - in.targets[h]).norm();
+      const double d = (x[idx(in.handles[h])] - in.targets[h]).norm();
       s.handleLags.emplace_back(in.handles[h], d);
       if (d > s.lag) {
         s.lag = d;
@@ -471,7 +465,7 @@ StrainLimitStats limitStrainOnce(const StrainLimitInput& in, std::vector<Vec3>& 
   };
   const double aim = kAim * in.bound;
   std::vector<char> held(in.pattern.size(), 0);
-  for (int h : in.handles) held[at(h)] = 1;
+  for (int h : in.handles) held[idx(h)] = 1;
   // 1. The stepped sheet, handles on their targets, first with the pins held
   // too. The projection lowers sum_e r_e^2, not the max, so the given sheet
   // stays a candidate.
@@ -480,7 +474,7 @@ StrainLimitStats limitStrainOnce(const StrainLimitInput& in, std::vector<Vec3>& 
   {
     std::vector<char> pinHeld = held;
     for (int v : in.pins)
-      if (static_cast<std::size_t>(v) < pinHeld.size()) pinHeld[at(v)] = 1;
+      if (inRange(pinHeld, v)) pinHeld[idx(v)] = 1;
     projector.holdAwayFrom(x, in.bound, kLocalRings, pinHeld);
     std::vector<Vec3> pinnedStep = x;
     placeHandles(pinnedStep, in.handles, in.targets);
@@ -500,7 +494,7 @@ StrainLimitStats limitStrainOnce(const StrainLimitInput& in, std::vector<Vec3>& 
   if (bestMax <= in.bound) return finish(std::move(best));
   // 2. The carried start: the step's start moved rigidly with the handles.
   std::vector<Vec3> from;
-  for (int h : in.handles) from.push_back(in.beforePositions[at(h)]);
+  for (int h : in.handles) from.push_back(in.beforePositions[idx(h)]);
   const RigidMotion motion = fitRigidMotion(from, in.targets);
   std::vector<Vec3> base = in.sameMesh ? in.beforePositions
                                        : transferByPattern(in.beforePattern, in.beforeTriangles,
@@ -519,7 +513,7 @@ StrainLimitStats limitStrainOnce(const StrainLimitInput& in, std::vector<Vec3>& 
   // 3. Lag: the handles on the way from their carried positions to their
   // targets, as far as the bound allows (bisection).
   std::vector<Vec3> start;
-  for (int h : in.handles) start.push_back(base[at(h)]);
+  for (int h : in.handles) start.push_back(base[idx(h)]);
   std::vector<Vec3> feasible = base;
   stats = projector.project(feasible, held, aim, in.iterations);
   s.iterations += stats.iterations;
@@ -550,7 +544,7 @@ StrainLimitStats limitStrainOnce(const StrainLimitInput& in, std::vector<Vec3>& 
     const auto sumLag = [&](const std::vector<Vec3>& p) {
       double sum = 0.0;
       for (std::size_t h = 0; h < in.handles.size(); ++h)
-        sum += (p[at(in.handles[h])] - in.targets[h]).squaredNorm();
+        sum += (p[idx(in.handles[h])] - in.targets[h]).squaredNorm();
       return sum;
     };
     std::vector<Vec3> towards = feasible;

@@ -17,6 +17,7 @@
 #include <span>
 
 #include "crumple/core/geometry2d.hpp"
+#include "crumple/core/index.hpp"
 
 namespace crumple::paper::detail {
 
@@ -47,7 +48,7 @@ PencilFrame chordLine(const GeometricMesh& g, const Pencil& pencil, double param
   const double c = std::cos(param);
   const double s = std::sin(param);
   const Vec2 d(c * pencil.dir.x() - s * pencil.dir.y(), s * pencil.dir.x() + c * pencil.dir.y());
-  return {g.vertices[static_cast<std::size_t>(pencil.apex)].pattern, d};
+  return {g.vertices[idx(pencil.apex)].pattern, d};
 }
 
 double paramOf(const GeometricMesh& g, const Pencil& pencil, const Vec2& p) {
@@ -55,7 +56,7 @@ double paramOf(const GeometricMesh& g, const Pencil& pencil, const Vec2& p) {
     const Vec2 n(-pencil.dir.y(), pencil.dir.x());
     return n.dot(p - pencil.origin);
   }
-  const Vec2 d = p - g.vertices[static_cast<std::size_t>(pencil.apex)].pattern;
+  const Vec2 d = p - g.vertices[idx(pencil.apex)].pattern;
   return std::atan2(cross2(pencil.dir, d), pencil.dir.dot(d));
 }
 
@@ -68,11 +69,11 @@ std::vector<std::pair<double, ChordEnd>> crossings(const GeometricMesh& g, const
   const std::size_t m = loop.size();
   std::vector<double> side(m);
   for (std::size_t k = 0; k < m; ++k) {
-    side[k] = n.dot(g.vertices[static_cast<std::size_t>(loop.v[k])].pattern - line.point);
+    side[k] = n.dot(g.vertices[idx(loop.v[k])].pattern - line.point);
     if (std::abs(side[k]) <= tol) side[k] = 0.0;
   }
   for (std::size_t k = 0; k < m; ++k) {
-    const Vec2& pa = g.vertices[static_cast<std::size_t>(loop.v[k])].pattern;
+    const Vec2& pa = g.vertices[idx(loop.v[k])].pattern;
     if (side[k] == 0.0) {
       ChordEnd e;
       e.p = pa;
@@ -82,7 +83,7 @@ std::vector<std::pair<double, ChordEnd>> crossings(const GeometricMesh& g, const
     }
     const double s1 = side[(k + 1) % m];
     if (s1 != 0.0 && (side[k] > 0.0) != (s1 > 0.0)) {
-      const Vec2& pb = g.vertices[static_cast<std::size_t>(loop.next(k))].pattern;
+      const Vec2& pb = g.vertices[idx(loop.next(k))].pattern;
       const double u = side[k] / (side[k] - s1);
       ChordEnd e;
       e.p = pa + u * (pb - pa);
@@ -94,12 +95,10 @@ std::vector<std::pair<double, ChordEnd>> crossings(const GeometricMesh& g, const
   return out;
 }
 
-bool loopEdgeOnBoundary(const Loop& loop, int k) {
-  return loop.across[static_cast<std::size_t>(k)] < 0;
-}
+bool loopEdgeOnBoundary(const Loop& loop, int k) { return loop.across[idx(k)] < 0; }
 
 bool vertexEndFree(const GeometricMesh& g, const Loop& loop, int k) {
-  return g.vertices[static_cast<std::size_t>(loop.v[static_cast<std::size_t>(k)])].onBoundary;
+  return g.vertices[idx(loop.v[idx(k)])].onBoundary;
 }
 
 struct Context {
@@ -175,7 +174,7 @@ std::optional<Chord> evaluateChord(const Context& c, const Pencil& pencil, doubl
   const Vec2 d = chord.b.p - chord.a.p;
   const double len2 = d.squaredNorm();
   for (int v : c.interior) {
-    const Vec2& p = c.g.vertices[static_cast<std::size_t>(v)].pattern;
+    const Vec2& p = c.g.vertices[idx(v)].pattern;
     const double t = (p - chord.a.p).dot(d) / len2;
     if (t > 0.0 && t < 1.0 &&
         std::abs(cross2(d, p - chord.a.p)) / std::sqrt(len2) <= 10.0 * c.tol) {
@@ -192,7 +191,7 @@ std::vector<double> stripParameters(const Context& c, const Pencil& pencil, doub
   std::vector<double> events;
   const auto addEvent = [&](int v) {
     if (v == pencil.apex) return;
-    events.push_back(paramOf(c.g, pencil, c.g.vertices[static_cast<std::size_t>(v)].pattern));
+    events.push_back(paramOf(c.g, pencil, c.g.vertices[idx(v)].pattern));
   };
   for (int v : c.loop.v) addEvent(v);
   for (int v : c.interior) addEvent(v);
@@ -288,8 +287,8 @@ CellShape cellShape(const GeometricMesh& g, const Ruling& r0, const Ruling& r1) 
   if (poly.size() > 1 && poly.front() == poly.back()) poly.pop_back();
   double twiceArea = 0.0, longest = 0.0;
   for (std::size_t k = 0; k < poly.size(); ++k) {
-    const Vec2& u = g.vertices[static_cast<std::size_t>(poly[k])].pattern;
-    const Vec2& w = g.vertices[static_cast<std::size_t>(poly[(k + 1) % poly.size()])].pattern;
+    const Vec2& u = g.vertices[idx(poly[k])].pattern;
+    const Vec2& w = g.vertices[idx(poly[(k + 1) % poly.size()])].pattern;
     twiceArea += cross2(u, w);
     longest = std::max(longest, (w - u).norm());
   }
@@ -314,8 +313,7 @@ bool spaceChords(const GeometricMesh& g, const Loop& loop, double tol, const Cru
       const int a = e.loopEdge;
       const int b = (a + 1) % m;
       for (int k : {a, b}) {
-        const Vec2& p =
-            g.vertices[static_cast<std::size_t>(loop.v[static_cast<std::size_t>(k)])].pattern;
+        const Vec2& p = g.vertices[idx(loop.v[idx(k)])].pattern;
         if ((e.p - p).norm() < snap) {
           e.p = p;
           e.vertex = k;
@@ -365,7 +363,7 @@ bool spaceChords(const GeometricMesh& g, const Loop& loop, double tol, const Cru
 // The loop path from x forwards to y (inclusive) along `loop`.
 std::vector<int> loopPath(const std::vector<int>& loop, int x, int y) {
   std::vector<int> out;
-  auto k = static_cast<std::size_t>(std::find(loop.begin(), loop.end(), x) - loop.begin());
+  auto k = idx(std::find(loop.begin(), loop.end(), x) - loop.begin());
   for (std::size_t n = 0; n <= loop.size(); ++n) {
     out.push_back(loop[k]);
     if (loop[k] == y) break;
@@ -385,9 +383,7 @@ std::vector<int> loopPath(const std::vector<int>& loop, int x, int y) {
 // Returns false (the strip is declined) when a cell cannot be split so.
 bool splitCellsAtCorners(const GeometricMesh& g, const Loop& loop, const std::vector<int>& newLoop,
                          const CrumpleParams& params, std::vector<Ruling>& rulings) {
-  const auto P = [&](int v) -> const Vec2& {
-    return g.vertices[static_cast<std::size_t>(v)].pattern;
-  };
+  const auto P = [&](int v) -> const Vec2& { return g.vertices[idx(v)].pattern; };
   // The loop path from x to y that passes neither ox nor oy (the other
   // chain's ends), inclusive; empty when there is none.
   const auto chain = [&](int x, int y, int ox, int oy) {
@@ -440,7 +436,7 @@ bool splitCellsAtCorners(const GeometricMesh& g, const Loop& loop, const std::ve
     }
     for (const std::vector<int>* c : {&ca, &cb})
       for (std::size_t q = 1; q + 1 < c->size(); ++q)
-        if (!g.vertices[static_cast<std::size_t>((*c)[q])].corner) return false;
+        if (!g.vertices[idx((*c)[q])].corner) return false;
     // best[i][j]: the widest thinnest cell of a walk from (0, 0) to ruling
     // (ca[i], cb[j]); from[i][j] the step taken into it.
     const std::size_t na = ca.size(), nb = cb.size();
@@ -492,18 +488,15 @@ Border findBorder(const GeometricMesh& g, const Loop& loop, const Vec2& origin, 
     border.hit = e.p;
     if (e.vertex >= 0) {
       // Through a vertex: free if on dS, otherwise treat the next edge.
-      border.kind = g.vertices[static_cast<std::size_t>(loop.v[static_cast<std::size_t>(e.vertex)])]
-                            .onBoundary
-                        ? Border::Kind::Free
-                        : Border::Kind::None;
+      border.kind = g.vertices[idx(loop.v[idx(e.vertex)])].onBoundary ? Border::Kind::Free
+                                                                      : Border::Kind::None;
       return border;
     }
     border.loopEdge = e.loopEdge;
-    const int across = loop.across[static_cast<std::size_t>(e.loopEdge)];
+    const int across = loop.across[idx(e.loopEdge)];
     if (across < 0) {
       border.kind = Border::Kind::Free;
-    } else if (g.regions[static_cast<std::size_t>(g.faces[static_cast<std::size_t>(across)].region)]
-                   .type == mesh::RegionType::Flat) {
+    } else if (g.regions[idx(g.faces[idx(across)].region)].type == mesh::RegionType::Flat) {
       border.kind = Border::Kind::FlatFlat;
     } else {
       border.kind = Border::Kind::Curved;
@@ -524,13 +517,13 @@ StripResult remeshStrip(GeometricMesh& g, int region, const Pencil& pencil,
   std::vector<int> interior;
   {
     std::vector<char> onLoop(g.vertices.size(), 0);
-    for (int v : loop.v) onLoop[static_cast<std::size_t>(v)] = 1;
+    for (int v : loop.v) onLoop[idx(v)] = 1;
     for (const GeometricFace& f : g.faces) {
       if (f.region != region) continue;
       for (int k = 0; k < f.size(); ++k) {
-        if (!onLoop[static_cast<std::size_t>(f.v[k])]) {
+        if (!onLoop[idx(f.v[k])]) {
           interior.push_back(f.v[k]);
-          onLoop[static_cast<std::size_t>(f.v[k])] = 1;
+          onLoop[idx(f.v[k])] = 1;
         }
       }
     }
@@ -561,11 +554,11 @@ StripResult remeshStrip(GeometricMesh& g, int region, const Pencil& pencil,
   // edges (several per edge are kept in order along it).
   std::map<int, std::vector<std::pair<double, int>>> onEdge;  // loop edge -> (u, new vertex)
   const auto endVertex = [&](const ChordEnd& e) {
-    if (e.vertex >= 0) return loop.v[static_cast<std::size_t>(e.vertex)];
-    const int a = loop.v[static_cast<std::size_t>(e.loopEdge)];
-    const int b = loop.next(static_cast<std::size_t>(e.loopEdge));
-    const Vec2& pa = g.vertices[static_cast<std::size_t>(a)].pattern;
-    const Vec2& pb = g.vertices[static_cast<std::size_t>(b)].pattern;
+    if (e.vertex >= 0) return loop.v[idx(e.vertex)];
+    const int a = loop.v[idx(e.loopEdge)];
+    const int b = loop.next(idx(e.loopEdge));
+    const Vec2& pa = g.vertices[idx(a)].pattern;
+    const Vec2& pb = g.vertices[idx(b)].pattern;
     const double u = (e.p - pa).norm() / (pb - pa).norm();
     // Snap onto an endpoint closer than a quarter of the ruling spacing (a
     // new vertex beside an existing one would make sliver triangles).
@@ -635,8 +628,8 @@ StripResult remeshStrip(GeometricMesh& g, int region, const Pencil& pencil,
     triangulatePolygon(g, side, addRegion(g, mesh::RegionType::Flat), interior);
   }
   const int curved = addRegion(g, mesh::RegionType::Curved);
-  g.regions[static_cast<std::size_t>(curved)].rulings = rulings;
-  g.regions[static_cast<std::size_t>(curved)].apex = pencil.apex;
+  g.regions[idx(curved)].rulings = rulings;
+  g.regions[idx(curved)].apex = pencil.apex;
   rebuildCurvedFaces(g, curved);
   return {true, {}};
 }

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "crumple/core/geometry2d.hpp"
+#include "crumple/core/index.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/tear/cut.hpp"
 
@@ -16,9 +17,7 @@ namespace crumple::paper {
 
 namespace {
 
-const Vec2& patternOf(const GeometricMesh& g, int v) {
-  return g.vertices[static_cast<std::size_t>(v)].pattern;
-}
+const Vec2& patternOf(const GeometricMesh& g, int v) { return g.vertices[idx(v)].pattern; }
 
 // Whether segments [a, b] and [c, d] meet (touching within tol counts).
 bool segmentsMeet(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d, double tol) {
@@ -34,13 +33,13 @@ bool segmentsMeet(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d, do
 // along it).
 bool advanceTouchesFace(const GeometricMesh& g, int f, const Vec2& from, const Vec2& to,
                         double tol) {
-  const GeometricFace& face = g.faces[static_cast<std::size_t>(f)];
+  const GeometricFace& face = g.faces[idx(f)];
   const int n = face.size();
   bool inside = true;  // `to` strictly inside the (counter-clockwise) face, if it is convex there
   double winding = 0.0;
   for (int k = 0; k < n; ++k) {
-    const Vec2& a = patternOf(g, face.v[static_cast<std::size_t>(k)]);
-    const Vec2& b = patternOf(g, face.v[static_cast<std::size_t>((k + 1) % n)]);
+    const Vec2& a = patternOf(g, face.v[idx(k)]);
+    const Vec2& b = patternOf(g, face.v[idx((k + 1) % n)]);
     if (segmentsMeet(from, to, a, b, tol)) return true;
     inside = inside && cross2(b - a, to - a) > 0.0;
     winding += std::atan2(cross2(a - to, b - to), (a - to).dot(b - to));
@@ -53,7 +52,7 @@ bool advanceTouchesFace(const GeometricMesh& g, int f, const Vec2& from, const V
 // halves counter-clockwise; its vertices stay where they are in the pattern
 // and in 3D.
 void flattenRegion(GeometricMesh& g, int r) {
-  Region& region = g.regions[static_cast<std::size_t>(r)];
+  Region& region = g.regions[idx(r)];
   region.type = mesh::RegionType::Flat;
   region.rulings.clear();
   region.apex = -1;
@@ -64,9 +63,7 @@ void flattenRegion(GeometricMesh& g, int r) {
       faces.push_back(f);
       continue;
     }
-    const auto P = [&](int k) -> const Vec2& {
-      return patternOf(g, f.v[static_cast<std::size_t>(k)]);
-    };
+    const auto P = [&](int k) -> const Vec2& { return patternOf(g, f.v[idx(k)]); };
     const auto ccw = [](const Vec2& a, const Vec2& b, const Vec2& c) {
       return cross2(b - a, c - a) > 0.0;
     };
@@ -96,15 +93,15 @@ std::map<int, int> boundaryNext(const GeometricMesh& g) {
   std::map<std::pair<int, int>, int> uses;
   for (const GeometricFace& f : g.faces)
     for (int k = 0; k < f.size(); ++k) {
-      const int a = f.v[static_cast<std::size_t>(k)];
-      const int b = f.v[static_cast<std::size_t>((k + 1) % f.size())];
+      const int a = f.v[idx(k)];
+      const int b = f.v[idx((k + 1) % f.size())];
       ++uses[{std::min(a, b), std::max(a, b)}];
     }
   std::map<int, int> next;
   for (const GeometricFace& f : g.faces)
     for (int k = 0; k < f.size(); ++k) {
-      const int a = f.v[static_cast<std::size_t>(k)];
-      const int b = f.v[static_cast<std::size_t>((k + 1) % f.size())];
+      const int a = f.v[idx(k)];
+      const int b = f.v[idx((k + 1) % f.size())];
       if (uses[{std::min(a, b), std::max(a, b)}] != 1) continue;
       if (!next.emplace(a, b).second)
         throw std::invalid_argument("cutGeometricMesh: the outline touches itself at vertex " +
@@ -123,9 +120,7 @@ void rebuildOutline(GeometricMesh& g, const Vec2& firstCorner, double perimeter)
   if (next.empty()) throw std::invalid_argument("cutGeometricMesh: S_G has no outline");
   int start = next.begin()->first;
   for (const auto& [a, b] : next)
-    if (g.vertices[static_cast<std::size_t>(a)].corner &&
-        (patternOf(g, a) - firstCorner).norm() == 0.0)
-      start = a;
+    if (g.vertices[idx(a)].corner && (patternOf(g, a) - firstCorner).norm() == 0.0) start = a;
   std::vector<int> loop;
   for (int v = start;;) {
     loop.push_back(v);
@@ -143,7 +138,7 @@ void rebuildOutline(GeometricMesh& g, const Vec2& firstCorner, double perimeter)
   const double straight = 1e-11 * perimeter;  // off the line through both neighbours: a corner
   std::vector<char> isCorner(n, 0);
   for (std::size_t k = 0; k < n; ++k) {
-    GeometricVertex& v = g.vertices[static_cast<std::size_t>(loop[k])];
+    GeometricVertex& v = g.vertices[idx(loop[k])];
     const Vec2& a = patternOf(g, loop[(k + n - 1) % n]);
     const Vec2& b = patternOf(g, loop[(k + 1) % n]);
     const double off = (b - a).norm() > 0.0
@@ -159,7 +154,7 @@ void rebuildOutline(GeometricMesh& g, const Vec2& firstCorner, double perimeter)
   g.outline.clear();
   int segment = -1;
   for (std::size_t k = 0; k < n; ++k) {
-    GeometricVertex& v = g.vertices[static_cast<std::size_t>(loop[k])];
+    GeometricVertex& v = g.vertices[idx(loop[k])];
     if (isCorner[k]) {
       g.outline.push_back(v.pattern);
       ++segment;
@@ -175,7 +170,7 @@ int flattenTouchedRegions(GeometricMesh& h, const Vec2& from, const Vec2& to, do
   std::set<int> curved;
   for (std::size_t f = 0; f < h.faces.size(); ++f) {
     const int r = h.faces[f].region;
-    if (h.regions[static_cast<std::size_t>(r)].type == mesh::RegionType::Curved &&
+    if (h.regions[idx(r)].type == mesh::RegionType::Curved &&
         advanceTouchesFace(h, static_cast<int>(f), from, to, tol))
       curved.insert(r);
   }
@@ -209,10 +204,9 @@ mesh::SheetMesh triangleMesh(const GeometricMesh& h) {
 void splitOutlineTriangle(mesh::SheetMesh& sm, int a, int b, int v) {
   for (std::size_t t = 0; t < sm.triangles.size(); ++t) {
     auto& tri = sm.triangles[t];
-    for (int k = 0; k < 3; ++k) {
-      if (tri[static_cast<std::size_t>(k)] != a || tri[static_cast<std::size_t>((k + 1) % 3)] != b)
-        continue;
-      const int c = tri[static_cast<std::size_t>((k + 2) % 3)];
+    for (std::size_t k = 0; k < 3; ++k) {
+      if (tri[k] != a || tri[(k + 1) % 3] != b) continue;
+      const int c = tri[(k + 2) % 3];
       const int face = sm.regionOfTriangle[t];
       tri = {a, v, c};
       addTriangle(sm, v, b, c, face);
@@ -239,8 +233,8 @@ int tearStartVertex(GeometricMesh& h, mesh::SheetMesh& sm, const Vec2& from, dou
       const double u = std::clamp((from - pa).dot(pb - pa) / (pb - pa).squaredNorm(), 0.0, 1.0);
       GeometricVertex nv;
       nv.pattern = pa + u * (pb - pa);
-      const GeometricVertex& va = h.vertices[static_cast<std::size_t>(a)];
-      const GeometricVertex& vb = h.vertices[static_cast<std::size_t>(b)];
+      const GeometricVertex& va = h.vertices[idx(a)];
+      const GeometricVertex& vb = h.vertices[idx(b)];
       nv.position = (1.0 - u) * va.position + u * vb.position;
       nv.velocity = (1.0 - u) * va.velocity + u * vb.velocity;
       nv.onBoundary = true;
@@ -265,11 +259,8 @@ void addCutVertices(GeometricMesh& h, const mesh::SheetMesh& sm, const tear::Cut
     GeometricVertex nv;
     nv.pattern = sm.pattern[i];
     nv.position = sm.positions[i];
-    for (int k = 0; k < 3; ++k)
-      if (b.vertex[static_cast<std::size_t>(k)] >= 0)
-        nv.velocity +=
-            b.weight[static_cast<std::size_t>(k)] *
-            h.vertices[static_cast<std::size_t>(b.vertex[static_cast<std::size_t>(k)])].velocity;
+    for (std::size_t k = 0; k < 3; ++k)
+      if (b.vertex[k] >= 0) nv.velocity += b.weight[k] * h.vertices[idx(b.vertex[k])].velocity;
     nv.onBoundary = true;
     Vec3 x, v;
     if (options.surface && options.surface(nv.pattern, x, v) && x.allFinite() && v.allFinite()) {
@@ -285,7 +276,7 @@ void addCutVertices(GeometricMesh& h, const mesh::SheetMesh& sm, const tear::Cut
 std::vector<GeometricFace> facesAfterCut(const GeometricMesh& h, const mesh::SheetMesh& sm) {
   std::vector<std::vector<std::array<int, 3>>> pieces(h.faces.size());
   for (std::size_t t = 0; t < sm.triangles.size(); ++t)
-    pieces[static_cast<std::size_t>(sm.regionOfTriangle[t])].push_back(sm.triangles[t]);
+    pieces[idx(sm.regionOfTriangle[t])].push_back(sm.triangles[t]);
   std::vector<GeometricFace> faces;
   for (std::size_t f = 0; f < h.faces.size(); ++f) {
     const GeometricFace& old = h.faces[f];
@@ -332,14 +323,12 @@ std::vector<std::pair<int, Vec2>> kerfMoves(const GeometricMesh& h, const std::v
       in = previousDirection->normalized();
     for (const int c : {cut.chain[k], cut.twins[k]}) {
       Vec2 centroid = Vec2::Zero();
-      for (int f : trianglesOf[static_cast<std::size_t>(c)])
+      for (int f : trianglesOf[idx(c)])
         centroid += (patternArea(h, f) > 0.0 ? 1.0 : 0.0) *
-                    (patternOf(h, h.faces[static_cast<std::size_t>(f)].v[0]) +
-                     patternOf(h, h.faces[static_cast<std::size_t>(f)].v[1]) +
-                     patternOf(h, h.faces[static_cast<std::size_t>(f)].v[2])) /
+                    (patternOf(h, h.faces[idx(f)].v[0]) + patternOf(h, h.faces[idx(f)].v[1]) +
+                     patternOf(h, h.faces[idx(f)].v[2])) /
                     3.0;
-      centroid /= static_cast<double>(
-          std::max<std::size_t>(1, trianglesOf[static_cast<std::size_t>(c)].size()));
+      centroid /= static_cast<double>(std::max<std::size_t>(1, trianglesOf[idx(c)].size()));
       const double side = cross2(out, centroid - p) > 0.0 ? 1.0 : -1.0;
       Vec2 move;
       if (in) {
@@ -421,22 +410,21 @@ std::optional<GeometricCutResult> cutGeometricMesh(GeometricMesh& g, const Vec2&
   // tear's first copies slide along their outline edge instead. s_{t+1}
   // stays: the slit is a V there.
   std::vector<Vec2> centre;
-  for (int v : cut.chain) centre.push_back(sm.pattern[static_cast<std::size_t>(v)]);
+  for (int v : cut.chain) centre.push_back(sm.pattern[idx(v)]);
   result.cut = centre;
   std::vector<std::vector<int>> trianglesOf(h.vertices.size());
   for (std::size_t f = 0; f < h.faces.size(); ++f)
     for (int k = 0; k < h.faces[f].size(); ++k)
-      trianglesOf[static_cast<std::size_t>(h.faces[f].v[static_cast<std::size_t>(k)])].push_back(
-          static_cast<int>(f));
+      trianglesOf[idx(h.faces[f].v[idx(k)])].push_back(static_cast<int>(f));
   const std::vector<std::pair<int, Vec2>> moves =
       kerfMoves(h, centre, cut, w, previousDirection, trianglesOf);
-  for (const auto& [c, move] : moves) h.vertices[static_cast<std::size_t>(c)].pattern += move;
+  for (const auto& [c, move] : moves) h.vertices[idx(c)].pattern += move;
   for (const auto& [c, move] : moves)
-    for (int f : trianglesOf[static_cast<std::size_t>(c)])
+    for (int f : trianglesOf[idx(c)])
       if (!(patternArea(h, f) > 0.0))
         throw std::invalid_argument("cutGeometricMesh: the kerf folds a face over");
-  h.vertices[static_cast<std::size_t>(cut.tip)].corner = true;
-  h.vertices[static_cast<std::size_t>(cut.tip)].onBoundary = true;
+  h.vertices[idx(cut.tip)].corner = true;
+  h.vertices[idx(cut.tip)].onBoundary = true;
 
   rebuildOutline(h, g.outline.front(), perimeter);
   if (const std::string problem = validate(h); !problem.empty())
