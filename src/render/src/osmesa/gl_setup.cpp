@@ -127,6 +127,19 @@ void OsmesaRenderer::Impl::createGeometry() {
   floatAttribute<PatchVertex>(2, 2, offsetof(PatchVertex, uv));
   floatAttribute<PatchVertex>(3, 2, offsetof(PatchVertex, maskUv));
   bindNewVertexArray(overlayVao, overlayVbo);
+  const auto stride = static_cast<GLsizei>(sizeof(detail::OverlayVertex));
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, stride,
+                        reinterpret_cast<const void*>(offsetof(detail::OverlayVertex, clip)));
+  glEnableVertexAttribArray(1);
+  glVertexAttribPointer(1, 4, GL_UNSIGNED_BYTE, GL_TRUE, stride,
+                        reinterpret_cast<const void*>(offsetof(detail::OverlayVertex, color)));
+  glBindVertexArray(0);
+
+  glGenTextures(1, &paperTex);
+  glGenTextures(1, &maskTex);
+  glGenBuffers(1, &triColorBuffer);
+  glGenTextures(1, &triColorTex);
 }
 
 void OsmesaRenderer::Impl::uploadTriangleColors(const std::vector<Vec3>& colors) {
