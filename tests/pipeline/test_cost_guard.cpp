@@ -2,6 +2,7 @@
 // "The cost guard"): its budget, its halvings rule and the causes it names.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <string>
 #include <vector>
 
@@ -126,6 +127,26 @@ TEST(WorkBudget, AnArmedBudgetThatRanOutStopsTheNextCheck) {
   checkWorkBudget("disarmed");  // the scope ended: no deadline
   const ScopedWorkBudget generous(3600.0);
   EXPECT_NO_THROW(checkWorkBudget("elastic"));
+}
+
+// Checks read the process's CPU clock (a system call) at most every few
+// milliseconds of wall time, so that a loop may check at every sweep: a
+// budget that runs out between two reads still stops a check soon after.
+TEST(WorkBudget, ABudgetThatRunsOutBetweenClockReadsStillStopsTheLoop) {
+  const ScopedWorkBudget budget(0.02);  // 20 ms of CPU time
+  checkWorkBudget("isometry");          // within it
+  const auto start = std::chrono::steady_clock::now();
+  bool stopped = false;
+  volatile double sink = 0.0;
+  while (!stopped && std::chrono::steady_clock::now() - start < std::chrono::seconds(30)) {
+    for (int i = 0; i < 1000; ++i) sink = sink + i;
+    try {
+      checkWorkBudget("isometry");
+    } catch (const WorkBudgetExceeded&) {
+      stopped = true;
+    }
+  }
+  EXPECT_TRUE(stopped) << "an armed budget never stopped a busy loop";
 }
 
 }  // namespace
