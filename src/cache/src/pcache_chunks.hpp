@@ -16,19 +16,20 @@
 
 namespace crumple::cache::detail {
 
-constexpr std::array<std::uint8_t, 8> kFileMagic{'P', 'C', 'A', 'C', 'H', 'E', 0x00, 0x01};
-constexpr std::array<std::uint8_t, 8> kEndMagic{'P', 'C', 'A', 'C', 'H', 'E', 'N', 'D'};
-constexpr Tag kHeadTag{'H', 'E', 'A', 'D'};
-constexpr Tag kFrameTag{'F', 'R', 'A', 'M'};
-constexpr Tag kFootTag{'F', 'O', 'O', 'T'};
-constexpr std::uint32_t kHeadVersion = 1;
-constexpr std::uint32_t kFrameVersion = 1;
-constexpr std::uint32_t kFootVersion = 1;
-constexpr std::uint64_t kChunkPrefix = 16;                  // tag, version, payload length
-constexpr std::uint64_t kChunkOverhead = kChunkPrefix + 4;  // ... and the CRC after the payload
-constexpr std::uint64_t kTrailerSize = 16;                  // footer offset, end magic
-constexpr std::uint64_t kFootEntrySize = 16;                // frame, offset, topology source
-constexpr std::uint8_t kFlagTopology = 0x01;
+inline constexpr std::array<std::uint8_t, 8> kFileMagic{'P', 'C', 'A', 'C', 'H', 'E', 0x00, 0x01};
+inline constexpr std::array<std::uint8_t, 8> kEndMagic{'P', 'C', 'A', 'C', 'H', 'E', 'N', 'D'};
+inline constexpr Tag kHeadTag{'H', 'E', 'A', 'D'};
+inline constexpr Tag kFrameTag{'F', 'R', 'A', 'M'};
+inline constexpr Tag kFootTag{'F', 'O', 'O', 'T'};
+inline constexpr std::uint32_t kHeadVersion = 1;
+inline constexpr std::uint32_t kFrameVersion = 1;
+inline constexpr std::uint32_t kFootVersion = 1;
+inline constexpr std::uint64_t kChunkPrefix = 16;  // tag, version, payload length
+inline constexpr std::uint64_t kChunkOverhead =
+    kChunkPrefix + 4;                                // ... and the CRC after the payload
+inline constexpr std::uint64_t kTrailerSize = 16;    // footer offset, end magic
+inline constexpr std::uint64_t kFootEntrySize = 16;  // frame, offset, topology source
+inline constexpr std::uint8_t kFlagTopology = 0x01;
 
 std::string hex32(std::uint32_t v);
 // A tag as text, unprintable bytes escaped.
