@@ -27,14 +27,16 @@ double CostGuard::median() const {
 
 double CostGuard::budget() const {
   if (fixed_) return *fixed_;
-  if (static_cast<int>(seconds_.size()) < kWarmUpFrames) return kFirstFramesBudget;
-  return std::max(kFirstFramesBudget, kRunawayFactor * median());
+  const double least = kFirstFramesBudget * slowness_;
+  if (static_cast<int>(seconds_.size()) < kWarmUpFrames) return least;
+  return std::max(least, kRunawayFactor * median());
 }
 
 void CostGuard::frameDone(int frame, double seconds, long halvings, const std::string& cause) {
   if (fixed_ && *fixed_ == 0.0) return;  // frame_budget_s = 0: the guard is off
   const bool warm = static_cast<int>(seconds_.size()) >= kWarmUpFrames;
-  const double slowAbove = warm ? std::max(kLeastSlowFrame, kSlowFactor * median()) : 0.0;
+  const double slowAbove =
+      warm ? std::max(kLeastSlowFrame * slowness_, kSlowFactor * median()) : 0.0;
   const double typical = warm ? median() : 0.0;
   seconds_.push_back(seconds);
   slow_ = !fixed_ && warm && seconds > slowAbove ? slow_ + 1 : 0;
@@ -42,8 +44,10 @@ void CostGuard::frameDone(int frame, double seconds, long halvings, const std::s
   std::string problem;
   if (slow_ >= kSlowFrames)
     problem = format("%.0f frames in a row each took more than %.3g s", kSlowFrames, slowAbove) +
-              format(" (%.3g s this one; the shot's median frame is %.3g s): the shot is crawling",
-                     seconds, typical);
+              format(" (%.3g s this one; the shot's median frame is %.3g s", seconds, typical) +
+              format("; at least %.3g s here, %.3g s on the reference machine",
+                     kLeastSlowFrame * slowness_, kLeastSlowFrame) +
+              format(" times this one's slowness, %.2g): the shot is crawling", slowness_);
   else if (crawling_ >= kHalvingFrames)
     problem = "the solver halved its substep more than " + std::to_string(kHalvingsPerFrame) +
               " times a frame on " + std::to_string(kHalvingFrames) + " frames in a row (" +
@@ -66,8 +70,13 @@ NumericalError CostGuard::budgetError(int frame, const std::string& stage,
   const double b = budget();
   std::string problem = format("the frame ran past its budget of %.3g s", b);
   if (!fixed_ && static_cast<int>(seconds_.size()) >= kWarmUpFrames)
-    problem += format(" (%.0fx the shot's median frame, at least %.0f s)", kRunawayFactor,
-                      kFirstFramesBudget);
+    problem += format(" (%.0fx the shot's median frame, at least %.3g s here", kRunawayFactor,
+                      kFirstFramesBudget * slowness_);
+  else if (!fixed_)
+    problem += format(" (the first frames' budget: %.3g s here", kFirstFramesBudget * slowness_);
+  if (!fixed_)
+    problem += format(", %.3g s on the reference machine times this one's slowness, %.2g)",
+                      kFirstFramesBudget, slowness_);
   problem += cause.empty() ? "" : "; likely cause: " + cause;
   problem += "; [scene] frame_budget_s sets the budget (0: the guard is off)";
   return NumericalError(stage, frame, problem);

@@ -19,6 +19,11 @@ namespace crumple::pipeline {
 
 class CostGuard {
  public:
+  // The floors below are CPU seconds on the development machine's Release
+  // build; the guard multiplies them by the process's slowness against it
+  // (core/machine_speed.hpp), so that they mean the same work on a slower
+  // machine or in a sanitized build.
+  //
   // A runaway frame (stopped inside its stages, core/work_budget.hpp): its
   // budget is kFirstFramesBudget until the shot has kWarmUpFrames frames of
   // its own, then the larger of that and kRunawayFactor x their median.
@@ -26,12 +31,13 @@ class CostGuard {
   static constexpr double kRunawayFactor = 100.0;
   static constexpr int kWarmUpFrames = 5;
   // A crawl (judged after each frame): kSlowFrames frames in a row, each
-  // slower than kSlowFactor x the median and than kLeastSlowFrame. A single
-  // dear frame (a tear, a hand-over) is not one: tear-straight's dearest is
-  // 58x its median, between cheap ones.
+  // slower than kSlowFactor x the median and than kLeastSlowFrame. A tear's
+  // dear frames are not one: samples/tear-fast's run of dear frames is
+  // 9.4, 8.8, 20.1, 15.7 and 7.8 s against a median of 0.19 s; a handle
+  // thrown out of reach costs 40-83 s a frame, frame after frame.
   static constexpr double kSlowFactor = 20.0;
-  static constexpr double kLeastSlowFrame = 10.0;  // s
-  static constexpr int kSlowFrames = 3;
+  static constexpr double kLeastSlowFrame = 20.0;  // s
+  static constexpr int kSlowFrames = 5;
   // Or kHalvingFrames frames in a row that each halve their substep more
   // than kHalvingsPerFrame times.
   static constexpr long kHalvingsPerFrame = 64;
@@ -40,10 +46,13 @@ class CostGuard {
   // fixedBudget: [scene] frame_budget_s. nullopt: the rules above. A number
   // > 0: that budget for every frame instead of the runaway and crawl rules
   // (the halvings rule stays). 0: the guard is off.
-  explicit CostGuard(std::optional<double> fixedBudget) : fixed_(fixedBudget) {}
-  // Wall-clock seconds the next frame may take (0: unlimited).
+  // slowness: the process's, machineSlowness() (> 0; unused with a fixed
+  // budget).
+  CostGuard(std::optional<double> fixedBudget, double slowness)
+      : fixed_(fixedBudget), slowness_(slowness) {}
+  // CPU seconds the next frame may take (0: unlimited).
   double budget() const;
-  // After a frame: its wall-clock time and halvings. Throws NumericalError
+  // After a frame: its CPU seconds and halvings. Throws NumericalError
   // (stage "cost guard") on a crawl or on the halvings rule; `cause` is
   // appended.
   void frameDone(int frame, double seconds, long halvings, const std::string& cause);
@@ -57,6 +66,7 @@ class CostGuard {
  private:
   double median() const;
   std::optional<double> fixed_;
+  double slowness_;
   std::vector<double> seconds_;  // the frames so far
   int slow_ = 0;                 // frames in a row over the crawl threshold
   int crawling_ = 0;             // frames in a row over kHalvingsPerFrame

@@ -9,6 +9,7 @@
 #include "crumple/cache/pcache_structure.hpp"
 #include "crumple/cache/pcache_tear.hpp"
 #include "crumple/core/error.hpp"
+#include "crumple/core/machine_speed.hpp"
 #include "crumple/core/work_budget.hpp"
 #include "shot_detail.hpp"
 
@@ -53,7 +54,9 @@ void noteSpan(int happened, int frame, ShotReport::FrameSpan& span) {
 }  // namespace
 
 ShotRunner::ShotRunner(const io::SceneSpec& scene, const ShotOptions& options)
-    : scene_(scene), plan_(planShot(scene, options)), guard_(plan_.frameBudget) {
+    : scene_(scene),
+      plan_(planShot(scene, options)),
+      guard_(plan_.frameBudget, plan_.frameBudget ? 1.0 : machineSlowness()) {
   report_.outDir = plan_.outDir;
   if (!scene.animationFile.empty()) {
     animation_ =

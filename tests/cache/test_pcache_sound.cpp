@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "crumple/cache/pcache_sound.hpp"
@@ -89,8 +90,16 @@ TEST(PcacheSound, EncodersRejectWhatTheDecoderWould) {
   events[0].kind = static_cast<sound::EventKind>(4);
   EXPECT_THROW(encodeSoundEvents(events), std::invalid_argument);
   events = someEvents();
-  events[1].resonators[0].area = -1.0;
-  EXPECT_THROW(encodeSoundEvents(events), std::invalid_argument);
+  events[1].resonators.back().area = -1.0;
+  try {
+    encodeSoundEvents(events);
+    FAIL() << "a negative resonator area was encoded";
+  } catch (const std::invalid_argument& e) {
+    // The event and its resonator are named.
+    const std::string expected =
+        "event 1: resonator " + std::to_string(events[1].resonators.size() - 1) + ": ";
+    EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+  }
   events = someEvents();
   events[2].position.x() = std::nan("");
   EXPECT_THROW(encodeSoundEvents(events), std::invalid_argument);

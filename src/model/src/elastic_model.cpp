@@ -114,6 +114,18 @@ void ElasticModel::restoreState(StateReader& in) {
   mesh_ = mesh::restoreSheetMesh(in);
   sheet_ = sim::ElasticSheet(mesh_, context_->material, context_->sim);
   attach();
+  restoreOnMesh(in);
+}
+
+std::unique_ptr<ElasticModel> ElasticModel::restored(StateReader& in,
+                                                     std::shared_ptr<const ModelContext> context,
+                                                     HandleRig& rig) {
+  auto model = std::make_unique<ElasticModel>(mesh::restoreSheetMesh(in), std::move(context), rig);
+  model->restoreOnMesh(in);
+  return model;
+}
+
+void ElasticModel::restoreOnMesh(StateReader& in) {
   sheet_.restoreState(in);
   mesh_.positions = sheet_.positions();
   singular_ = in.i32s();

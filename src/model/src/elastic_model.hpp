@@ -37,6 +37,11 @@ class ElasticModel final : public SheetModel {
 
   void saveState(StateWriter& out) const override;
   void restoreState(StateReader& in) override;
+  // The model a checkpoint holds, its FEM built once on the saved mesh (a
+  // crumpling-model sheet handed over to the elastic model).
+  static std::unique_ptr<ElasticModel> restored(StateReader& in,
+                                                std::shared_ptr<const ModelContext> context,
+                                                HandleRig& rig);
 
   // A sheet just handed over settles: `steps` implicit steps of dt ending
   // at t, its pins where they are, then takes `velocities`.
@@ -45,6 +50,8 @@ class ElasticModel final : public SheetModel {
  private:
   // Contacts and the fingers' grips on the sheet `sheet_`.
   void attach();
+  // The state after the saved mesh, on a sheet built on it.
+  void restoreOnMesh(StateReader& in);
 
   std::shared_ptr<const ModelContext> context_;
   HandleRig& rig_;

@@ -144,16 +144,15 @@ void saveModel(StateWriter& out, const SheetModel& model) {
 
 void restoreModel(StateReader& in, std::unique_ptr<SheetModel>& model,
                   const std::shared_ptr<const ModelContext>& context, HandleRig& rig) {
-  if (in.boolean()) {
-    if (!model->crumpling())
-      in.fail("holds the crumpling model's state, the scene runs the elastic model");
+  const bool crumpling = in.boolean();
+  if (crumpling && !model->crumpling())
+    in.fail("holds the crumpling model's state, the scene runs the elastic model");
+  if (crumpling == model->crumpling()) {
     model->restoreState(in);
     return;
   }
-  // The elastic model, or a crumpling-model sheet handed over to it.
-  auto elastic = std::make_unique<ElasticModel>(context->elasticMesh(), context, rig);
-  elastic->restoreState(in);
-  model = std::move(elastic);
+  // A crumpling-model sheet handed over to the elastic model.
+  model = ElasticModel::restored(in, context, rig);
 }
 
 }  // namespace crumple::model
