@@ -212,7 +212,7 @@ struct SceneSpec {
   int frameEnd = 48;  // inclusive
   int substeps = 4;
   std::uint64_t seed = 1;
-  // [scene] frame_budget_s: the cost guard's wall-clock budget for one frame
+  // [scene] frame_budget_s: the cost guard's budget of CPU seconds for one frame
   // (docs/RELIABILITY.md "The cost guard"). Unset (nullopt): derived from the
   // shot's own frame times; 0: the cost guard is off.
   std::optional<double> frameBudget;
