@@ -40,8 +40,9 @@ all_scenes() {
 
 # A copy of each scene at a fixed path (its path is in the cache's header,
 # so both binaries must read it from the same place) with the cost guard off
-# ([scene] frame_budget_s = 0): the guard stops a run by wall-clock time, which
-# a loaded machine changes; it never changes what a finished run writes.
+# ([scene] frame_budget_s = 0): the guard stops a run by its CPU time, which
+# differs between machines and builds; it never changes what a finished run
+# writes.
 # Every sample folder is staged, whichever scenes run: a scene may read
 # another's files (backlit-cutout animates drape's glTF).
 stage_scenes() {
