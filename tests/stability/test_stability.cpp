@@ -11,6 +11,7 @@
 // appends one row per run to FILE (scripts/stability.sh prints the table).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -23,6 +24,7 @@
 #include "../pipeline/test_util.hpp"
 #include "crumple/cache/pcache.hpp"
 #include "crumple/core/error.hpp"
+#include "crumple/core/machine_speed.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/pipeline/inspect.hpp"
 
@@ -256,7 +258,11 @@ TEST_P(Stability, EndsFiniteValidAndBoundedOrWithAClearError) {
   const Bounds& bounds = hybrid ? c.hybrid : c.elastic;
   TempDir tmp;
   const fs::path scene = prepareScene(c, hybrid, tmp / "scene");
-  const int timeout = full ? c.timeoutFull : c.timeoutShort;
+  // The limits are the development machine's Release seconds, scaled by how
+  // much slower this build runs the reference workload (a sanitized build:
+  // about 7x; its elastic cases run 9-12x slower than in Release).
+  const int timeout = static_cast<int>(
+      std::ceil((full ? c.timeoutFull : c.timeoutShort) * std::max(1.0, machineSlowness())));
   std::string command = "env CRUMPLE_ASSETS=" + sourcePath("tests/stability") +
                         " timeout -s KILL " + std::to_string(timeout) + " " + CRUMPLE_BIN +
                         " simulate " + scene.string() + " --out " + (tmp / "out").string();
