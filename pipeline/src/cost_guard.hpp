@@ -34,7 +34,7 @@ class CostGuard {
   // slower than kSlowFactor x the median and than kLeastSlowFrame. A tear's
   // dear frames are not one: samples/tear-fast's run of dear frames is
   // 9.4, 8.8, 20.1, 15.7 and 7.8 s against a median of 0.19 s; a handle
-  // thrown out of reach costs 40-83 s a frame, frame after frame.
+  // thrown out of reach costs 62-84 s a frame, frame after frame.
   static constexpr double kSlowFactor = 20.0;
   static constexpr double kLeastSlowFrame = 20.0;  // s
   static constexpr int kSlowFrames = 5;
