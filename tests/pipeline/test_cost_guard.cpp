@@ -69,8 +69,8 @@ TEST(CostGuard, ItStopsAfterFramesInARowThatStayDear) {
 // slowness: tear-fast run 10x slower (a sanitized build on a slower machine)
 // goes on with the slowness it measured, and is stopped as crawling by a
 // guard that took it for the reference machine. The first frames' budget
-// scales too: tear-cylinder's hand-over frame (57 s in Release) takes about
-// 400 s in the sanitized build, past the unscaled 300 s.
+// scales too: tear-cylinder's hand-over frame (57 s in Release) would take
+// about 400 s at 7x, past the unscaled 300 s.
 TEST(CostGuard, ItsFloorsScaleWithTheMachinesSlowness) {
   const std::vector<double> tearFast = {0.14, 0.06, 0.03, 0.03, 0.03, 0.02, 0.03,  0.71,
                                         0.59, 0.70, 4.91, 2.07, 9.43, 8.75, 20.08, 15.73,
