@@ -11,19 +11,16 @@
 namespace crumple {
 namespace {
 
-// The process's CPU time in nanoseconds.
-std::int64_t cpuNanoseconds() {
+// A clock's reading in nanoseconds: the process's CPU time
+// (CLOCK_PROCESS_CPUTIME_ID) or the monotonic wall clock (a vDSO read, about
+// 25 ns here).
+std::int64_t nanoseconds(clockid_t clock) {
   timespec t{};
-  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  ::clock_gettime(clock, &t);
   return static_cast<std::int64_t>(t.tv_sec) * 1000000000 + t.tv_nsec;
 }
-
-// The monotonic clock in nanoseconds (a vDSO read, about 25 ns here).
-std::int64_t wallNanoseconds() {
-  timespec t{};
-  ::clock_gettime(CLOCK_MONOTONIC, &t);
-  return static_cast<std::int64_t>(t.tv_sec) * 1000000000 + t.tv_nsec;
-}
+std::int64_t cpuNanoseconds() { return nanoseconds(CLOCK_PROCESS_CPUTIME_ID); }
+std::int64_t wallNanoseconds() { return nanoseconds(CLOCK_MONOTONIC); }
 
 // The process's CPU clock is a system call (about 550 ns a read on the
 // development machine, against 25 ns for the monotonic clock), and the
