@@ -112,6 +112,14 @@ FrameMetrics measureFrame(const cache::FrameRecord& frame) {
         std::max(m.handleError,
                  (frame.positions[static_cast<std::size_t>(v)] - frame.handleTargets[h]).norm());
   }
+  m.centroid = sheetMoments(frame.triangles, frame.pattern, frame.positions).centroid;
+  Vec3 normalSum = Vec3::Zero();
+  for (std::size_t t = 0; t < frame.triangles.size(); ++t) normalSum += normal(static_cast<int>(t));
+  if (normalSum.norm() > 0.0) {
+    m.meanNormal = normalSum.normalized();
+    m.normalAngleDeg =
+        std::acos(std::clamp(m.meanNormal.y(), -1.0, 1.0)) * 180.0 / std::numbers::pi;
+  }
   const AngleDefect defect = angleDefect(frame.triangles, frame.positions, frame.singularVertices);
   m.meanAngleDefect = defect.mean;
   m.maxAngleDefect = defect.max;
@@ -260,7 +268,14 @@ std::string inspectJson(const cache::CacheReader& reader) {
   for (std::size_t i = 0; i < reader.frameCount(); ++i) {
     auto frame = reader.readFrame(i);
     auto m = measure(reader, frame);
-    if (previous) m.popping = poppingMeasure(*previous, frame);
+    if (previous) {
+      m.popping = poppingMeasure(*previous, frame);
+      if (frame.time > previous->time)
+        m.centroidVelocity =
+            (m.centroid -
+             sheetMoments(previous->triangles, previous->pattern, previous->positions).centroid) /
+            (frame.time - previous->time);
+    }
     const SelfPenetration self = selfPenetration(frame, header.paperThickness);
     m.selfDepth = self.depth;
     m.selfCrossings = self.crossings;
@@ -307,6 +322,13 @@ std::string inspectJson(const cache::CacheReader& reader) {
       j.key("self_depth").value(m.selfDepth);
       j.key("self_crossings").value(m.selfCrossings);
     }
+    const auto vec = [&j](const char* name, const Vec3& a) {
+      j.key(name).beginArray().value(a.x()).value(a.y()).value(a.z()).endArray();
+    };
+    vec("centroid", m.centroid);
+    vec("centroid_velocity", m.centroidVelocity);
+    vec("mean_normal", m.meanNormal);
+    j.key("normal_angle_deg").value(m.normalAngleDeg);
     j.key("extent")
         .beginArray()
         .value(m.extent.x())

@@ -37,7 +37,7 @@ SceneSpec SceneParser::parse() {
   const TableReader root(root_, "", file_);
   root.allowOnly({"scene", "sheet", "paper", "handles", "camera", "lights", "environment", "ground",
                   "props", "colliders", "friction", "contact", "tear", "sound", "output", "sim",
-                  "model"});
+                  "model", "air"});
   // [scene] first: its `units` scales every length that follows.
   parseScene(root.subTable("scene"));
   const toml::table* sheet = root.subTable("sheet");
@@ -59,6 +59,8 @@ SceneSpec SceneParser::parse() {
   parseSound(root.subTable("sound"));
   parseOutput(root.subTable("output"));
   parseSim(root.subTable("sim"));
+  // After [sim] (whose struct holds the air) and [scene] (the gusts' seed).
+  parseAir(root.subTable("air"));
   parseModel(root.subTable("model"));
   return std::move(spec_);
 }

@@ -8,6 +8,7 @@
 //   scene_view.cpp      [camera], [[lights]], [environment], [ground], [[props]]
 //   scene_contacts.cpp  [friction], [[colliders]], [contact]
 //   scene_model.cpp     [model], [sim], [tear], [sound]: the modules' parameters
+//   scene_air.cpp       [air]
 #include <string>
 #include <string_view>
 #include <vector>
@@ -65,6 +66,9 @@ class SceneParser {
   void parseSound(const toml::table* table);
   void parseSim(const toml::table* table);
   void parseModel(const toml::table* table);
+
+  // scene_air.cpp
+  void parseAir(const toml::table* table);
 
   std::string file_;
   std::string baseDir_;

@@ -170,6 +170,7 @@ bool ElasticSheet::Impl::newtonGradient(NewtonState& s, std::string& why) {
       if (fi >= 0) s.gradV.segment<3>(3 * fi) += g.segment<3>(3 * static_cast<int>(a));
     }
   }
+  if (air) addAirGradient(xk, h, s.gradV);
   s.grad = s.gradQ + s.gradV;
   if (!s.grad.allFinite()) {
     why = "non-finite forces";
@@ -229,6 +230,7 @@ bool ElasticSheet::Impl::assembleSystem(const NewtonState& s) {
           if (off[i] >= 0) values[off[i]] += grip.stiffness * grip.weights(a) * grip.weights(b);
         }
   }
+  if (air) addAirHessian(xk, s.h, values);
   return Eigen::Map<const VecX>(values, matrix.nonZeros()).allFinite();
 }
 
@@ -300,6 +302,7 @@ ElasticSheet::Impl::LineSearchResult ElasticSheet::Impl::lineSearch(NewtonState&
   }
   const double slopeQ = s.gradQ.dot(s.dx);
   const double contactNow = contactEnergy(s.xk, s.frictionEps) + gripEnergy(s.xk);
+  const double airNow = air ? airEnergy(s.xk, s.h) : 0.0;
   step = 1.0;
   for (int ls = 0; ls <= kMaxLineSearchHalvings; ++ls, step *= 0.5) {
     applyStep(s, step);
@@ -309,6 +312,7 @@ ElasticSheet::Impl::LineSearchResult ElasticSheet::Impl::lineSearch(NewtonState&
     for (std::size_t k = 0; k < hinges.size(); ++k) deltaV += hingeTrial[k] - hingeEnergy[k];
     if (!contactPlanes.empty() || !faceContacts.empty() || !gripBuffer.empty())
       deltaV += contactEnergy(s.xTrial, s.frictionEps) + gripEnergy(s.xTrial) - contactNow;
+    if (air) deltaV += airEnergy(s.xTrial, s.h) - airNow;
     const double deltaPhi = step * slopeQ + 0.5 * step * step * curvature + deltaV;
     if (std::isfinite(deltaPhi) && deltaPhi <= kArmijo * step * slope)
       return LineSearchResult::Accepted;
@@ -369,8 +373,15 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
   }
   if (!collectPins(t1, pins, why) || !collectGrips(t1, why)) return false;
   NewtonState s;
+  s.t0 = t0;
   s.h = t1 - t0;
   startNewton(s);
+  if (air) {
+    const auto begin = std::chrono::steady_clock::now();
+    air->beginStep(x, v, t0, t1, collidersOn() ? contact.colliders : nullptr);
+    stats.airMs +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin).count();
+  }
   findContacts(x, s.xk, s.h, stats);
   const bool debugNewton = debugOptions().newton;
   const double tol = params.newtonTolerance * typicalEdge;
@@ -475,6 +486,7 @@ StepStats ElasticSheet::advance(double t, double dt, const PinFunction& pins) {
     stats.solves += more.solves;
     stats.finalStepNorm = more.finalStepNorm;
     stats.contactMs += more.contactMs;
+    stats.airMs += more.airMs;
     stats.selfContactMs += more.selfContactMs;
     if (!done) why += std::string("; ") + what + ": " + moreWhy;
     return done;

@@ -78,6 +78,11 @@ ElasticSheet::Impl::Impl(const mesh::SheetMesh& m, const Material& material, con
   triangles = m.triangles;
   pattern = m.pattern;
   x = m.positions;
+  if (p.air) {
+    if (const std::string problem = airParamsProblem(*p.air); !problem.empty())
+      throw std::invalid_argument("ElasticSheet: air: " + problem);
+    air.emplace(*p.air, triangles, pattern, vertexCount);
+  }
   v.assign(vertexCount, Vec3::Zero());
 
   // Rest state and lumped mass (areal density * area / 3 per corner).

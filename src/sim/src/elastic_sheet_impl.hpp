@@ -22,6 +22,7 @@
 
 #include "crumple/core/error.hpp"
 #include "crumple/core/parallel.hpp"
+#include "crumple/sim/air.hpp"
 #include "crumple/sim/colliders.hpp"
 #include "crumple/sim/contact_energies.hpp"
 #include "crumple/sim/elastic_sheet.hpp"
@@ -211,6 +212,14 @@ struct ElasticSheet::Impl {
   int analyzeCount = 0;
   bool supernodal = false;  // which CHOLMOD factorisation the last analysis chose
 
+  // The air (docs/AIR.md; elastic_air.cpp): none unless params.air.
+  std::optional<AirModel> air;
+  // The air's part of the incremental potential at xs (J): its implicit
+  // terms and the work of its explicit forces.
+  double airEnergy(const std::vector<Vec3>& xs, double h) const;
+  void addAirGradient(const std::vector<Vec3>& xs, double h, VecX& out) const;
+  void addAirHessian(const std::vector<Vec3>& xs, double h, double* values) const;
+
   // ---- step scratch ----
   std::vector<Pin> pinBuffer;
   std::vector<int> pinTarget;  // vertex -> index into pinBuffer, -1 if free
@@ -227,6 +236,7 @@ struct ElasticSheet::Impl {
   // elastic_newton.cpp): the incremental potential's fixed parts, the
   // Newton iterate and its scratch.
   struct NewtonState {
+    double t0 = 0.0;
     double h = 0.0;
     double massDiag = 0.0;     // lumped mass / damping diagonal: 1/h^2 + alpha/h
     double dampScale = 0.0;    // Rayleigh stiffness damping beta / h

@@ -42,6 +42,15 @@ struct FrameMetrics {
   std::optional<cache::StructureChanges> structure;
   double selfDepth = 0.0;         // selfPenetration(...).depth (0 without a thickness)
   std::size_t selfCrossings = 0;  // selfPenetration(...).crossings
+  // The falling-paper regimes (docs/AIR.md): the sheet's centre of mass
+  // (uniform density over the pattern), the unit area-weighted mean of its
+  // triangles' normals (zero when they cancel) and that normal's angle from
+  // the world's up axis +y (deg, 0 level face up, 180 face down).
+  Vec3 centroid = Vec3::Zero();
+  Vec3 meanNormal = Vec3::Zero();
+  double normalAngleDeg = 0.0;
+  // (centroid - the frame before's) / time between them (m/s; 0 on the first).
+  Vec3 centroidVelocity = Vec3::Zero();
 };
 
 // How far the sheet passes into itself, for a paper of thickness h (m, from

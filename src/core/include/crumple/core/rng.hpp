@@ -13,6 +13,7 @@ enum class RngPurpose : std::uint32_t {
   FiberTexture = 2,
   SoundVariant = 3,
   Jitter = 4,
+  Gusts = 5,
 };
 
 class CounterRng {

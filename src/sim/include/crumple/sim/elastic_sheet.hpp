@@ -53,6 +53,7 @@ struct StepStats {
   double contactMs = 0.0;      // collider detection and failsafe, wall time (timing only)
   double selfContactMs = 0.0;  // self-contact gate, detection and failsafe (timing only)
   int selfContactSteps = 0;    // (sub)steps in which self-contact detection ran
+  double airMs = 0.0;          // the air's set-up per (sub)step, wall time (timing only)
   // Recovery of a step that failed even after halving (docs/STABILITY.md):
   // taken again with kRetryIterationFactor times the Newton iterations, or
   // else without self-contact (the sheet may pass through itself there).

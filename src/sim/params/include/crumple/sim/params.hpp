@@ -2,7 +2,10 @@
 // Parameters of the elastic step (ElasticSheet), header-only: the scene's
 // [sim] table fills them (io), the simulator runs them. The paper's material
 // is sim::Material (material.hpp).
+#include <optional>
+
 #include "crumple/core/types.hpp"
+#include "crumple/sim/air_params.hpp"
 
 namespace crumple::sim {
 
@@ -30,6 +33,8 @@ struct SimParams {
   // kRetryIterationFactor times maxNewtonIterations. Off by default; a shot
   // (pipeline::runShot) turns it on.
   bool recoverFailedSteps = false;
+  // The air (docs/AIR.md): none unless the scene has [air].
+  std::optional<AirParams> air;
 
   bool operator==(const SimParams&) const = default;
 };

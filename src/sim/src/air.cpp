@@ -1,0 +1,343 @@
+// Air on the sheet (sim/air.hpp; docs/AIR.md): the per-triangle
+// quasi-steady forces of Andersen, Pesavento & Wang 2005 (J. Fluid Mech.
+// 541, 65-90, eqs. (5.1)-(5.5)), their implicit and explicit parts.
+#include "crumple/sim/air.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "air_shelter.hpp"
+#include "crumple/sim/colliders.hpp"
+
+namespace crumple::sim {
+
+namespace {
+
+// Below this relative speed (m/s) the angle of attack is undefined and the
+// lift terms vanish.
+constexpr double kStill = 1e-9;
+
+// The connected pieces of the sheet: which one each triangle is in, and
+// each one's chord, twice its pattern area over its perimeter (a strip's
+// width, a disc's radius, half a square's side).
+struct Pieces {
+  std::vector<int> of;        // per triangle
+  std::vector<double> chord;  // per piece
+};
+
+Pieces findPieces(const std::vector<std::array<int, 3>>& triangles,
+                  const std::vector<Vec2>& pattern, std::size_t vertexCount) {
+  std::vector<std::size_t> parent(vertexCount);
+  std::iota(parent.begin(), parent.end(), std::size_t{0});
+  const auto find = [&parent](std::size_t a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  for (const auto& t : triangles)
+    for (int k = 1; k < 3; ++k) {
+      const std::size_t a = find(static_cast<std::size_t>(t[0]));
+      const std::size_t b = find(static_cast<std::size_t>(t[static_cast<std::size_t>(k)]));
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  std::vector<double> area(vertexCount, 0.0), perimeter(vertexCount, 0.0);
+  // Boundary edges: used by one triangle (counted with a sorted edge list).
+  std::vector<std::pair<int, int>> edges;
+  edges.reserve(3 * triangles.size());
+  for (const auto& t : triangles) {
+    const Vec2 e1 =
+        pattern[static_cast<std::size_t>(t[1])] - pattern[static_cast<std::size_t>(t[0])];
+    const Vec2 e2 =
+        pattern[static_cast<std::size_t>(t[2])] - pattern[static_cast<std::size_t>(t[0])];
+    area[find(static_cast<std::size_t>(t[0]))] += 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[static_cast<std::size_t>(k)], b = t[static_cast<std::size_t>((k + 1) % 3)];
+      edges.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j] == edges[i]) ++j;
+    if (j - i == 1) {
+      const auto a = static_cast<std::size_t>(edges[i].first);
+      const auto b = static_cast<std::size_t>(edges[i].second);
+      perimeter[find(a)] += (pattern[a] - pattern[b]).norm();
+    }
+    i = j;
+  }
+  Pieces pieces;
+  std::vector<int> index(vertexCount, -1);
+  for (const auto& t : triangles) {
+    const std::size_t root = find(static_cast<std::size_t>(t[0]));
+    if (index[root] < 0) {
+      index[root] = static_cast<int>(pieces.chord.size());
+      pieces.chord.push_back(perimeter[root] > 0.0 ? 2.0 * area[root] / perimeter[root]
+                                                   : std::sqrt(area[root]));
+    }
+    pieces.of.push_back(index[root]);
+  }
+  return pieces;
+}
+
+// Every piece's motion as a rigid body at (x, v), uniform density over its
+// triangles: the centre's velocity and the spin that carries its angular
+// momentum (I omega = L about the centre).
+void pieceMotion(const std::vector<std::array<int, 3>>& triangles, const Pieces& pieces,
+                 const std::vector<Vec3>& x, const std::vector<Vec3>& v,
+                 std::vector<Vec3>& velocity, std::vector<Vec3>& spin) {
+  const std::size_t np = pieces.chord.size();
+  std::vector<double> mass(np, 0.0);
+  std::vector<Vec3> centre(np, Vec3::Zero());
+  velocity.assign(np, Vec3::Zero());
+  spin.assign(np, Vec3::Zero());
+  const auto corners = [&](std::size_t t, const std::vector<Vec3>& f) {
+    return std::array<Vec3, 3>{f[static_cast<std::size_t>(triangles[t][0])],
+                               f[static_cast<std::size_t>(triangles[t][1])],
+                               f[static_cast<std::size_t>(triangles[t][2])]};
+  };
+  std::vector<double> area(triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const auto p = corners(t, x), w = corners(t, v);
+    area[t] = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
+    const auto k = static_cast<std::size_t>(pieces.of[t]);
+    mass[k] += area[t];
+    centre[k] += area[t] * (p[0] + p[1] + p[2]) / 3.0;
+    velocity[k] += area[t] * (w[0] + w[1] + w[2]) / 3.0;
+  }
+  for (std::size_t k = 0; k < np; ++k)
+    if (mass[k] > 0.0) {
+      centre[k] /= mass[k];
+      velocity[k] /= mass[k];
+    }
+  std::vector<Mat3> inertia(np, Mat3::Zero());
+  std::vector<Vec3> momentum(np, Vec3::Zero());
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const auto k = static_cast<std::size_t>(pieces.of[t]);
+    const auto p = corners(t, x), w = corners(t, v);
+    // A uniform triangle's second moment and angular momentum about the
+    // piece's centre: (A/12) sum over its corners plus A at its centroid.
+    const Vec3 c = (p[0] + p[1] + p[2]) / 3.0, vc = (w[0] + w[1] + w[2]) / 3.0;
+    const auto add = [&](const Vec3& r, const Vec3& dv, double weight) {
+      inertia[k] += weight * (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
+      momentum[k] += weight * r.cross(dv);
+    };
+    add(c - centre[k], vc - velocity[k], area[t]);
+    for (std::size_t a = 0; a < 3; ++a) add(p[a] - c, w[a] - vc, area[t] / 12.0);
+  }
+  for (std::size_t k = 0; k < np; ++k) {
+    // A piece with no extent about an axis has no spin about it.
+    const Eigen::SelfAdjointEigenSolver<Mat3> eig(inertia[k]);
+    const double floor = 1e-9 * eig.eigenvalues().maxCoeff();
+    Vec3 omega = Vec3::Zero();
+    for (int i = 0; i < 3; ++i)
+      if (eig.eigenvalues()(i) > floor)
+        omega += eig.eigenvectors().col(i) *
+                 (eig.eigenvectors().col(i).dot(momentum[k]) / eig.eigenvalues()(i));
+    spin[k] = omega;
+  }
+}
+
+}  // namespace
+
+std::string airParamsProblem(const AirParams& p) {
+  const auto finiteNonNegative = [](double v) { return std::isfinite(v) && v >= 0.0; };
+  if (!(std::isfinite(p.density) && p.density > 0.0)) return "density must be positive";
+  if (!finiteNonNegative(p.dragNormal) || !finiteNonNegative(p.dragTangential) ||
+      !finiteNonNegative(p.translationalLift) || !finiteNonNegative(p.rotationalLift) ||
+      !finiteNonNegative(p.addedMass))
+    return "the coefficients must be finite and non-negative";
+  for (const WindKey& k : p.wind)
+    if (!std::isfinite(k.time) || !k.velocity.allFinite()) return "a wind key is not finite";
+  const GustParams& g = p.gusts;
+  if (!finiteNonNegative(g.speed) || !(g.lengthScale > 0.0) || !std::isfinite(g.lengthScale) ||
+      !(g.timeScale > 0.0) || !std::isfinite(g.timeScale) || g.modes < 0)
+    return "gusts need a finite speed >= 0, positive length and time scales and modes >= 0";
+  return {};
+}
+
+double airTriangleEnergy(const AirTriangleFrame& f, double h, const Vec3& x0, const Vec3& x1,
+                         const Vec3& x2, Vec9* gradient, Mat9* hessian) {
+  const Vec3 c = (x0 + x1 + x2) / 3.0;
+  const Vec3 u = (c - f.centroidStart) / h - f.wind;
+  const double speed = u.norm();
+  const double d = f.normal.dot(c - f.inertiaTarget);
+  const double h2 = h * h;
+  // paper eq. (5.5)'s drag as a convex potential in u; added mass as inertia.
+  const double energy = h * f.drag / 3.0 * speed * speed * speed + 0.5 * f.addedMass * d * d / h2;
+  if (gradient) {
+    const Vec3 gc = f.drag * speed * u + (f.addedMass * d / h2) * f.normal;
+    for (int a = 0; a < 3; ++a) gradient->segment<3>(3 * a) = gc / 3.0;
+  }
+  if (hessian) {
+    Mat3 hc = (f.addedMass / h2) * f.normal * f.normal.transpose();
+    if (speed > 0.0) hc += (f.drag / h) * (speed * Mat3::Identity() + u * u.transpose() / speed);
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) hessian->block<3, 3>(3 * a, 3 * b) = hc / 9.0;
+  }
+  return energy;
+}
+
+std::array<Vec3, 3> airExplicitForces(const AirParams& p, const AirExplicitInput& in) {
+  std::array<Vec3, 3> out{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+  const Vec3 e1 = in.x[1] - in.x[0], e2 = in.x[2] - in.x[0];
+  const Vec3 big = e1.cross(e2);
+  const double twiceArea = big.norm();
+  if (!(twiceArea > 0.0) || !(in.exposure > 0.0)) return out;
+  const Vec3 n = big / twiceArea;
+  const double area = 0.5 * twiceArea;
+  const Vec3 u = (in.v[0] + in.v[1] + in.v[2]) / 3.0 - in.wind;
+  const double un = u.dot(n);
+  const Vec3 ut = u - un * n;
+  // The normal's rate: the tangential part of d(e1 x e2)/dt over |e1 x e2|.
+  const Vec3 bigRate = (in.v[1] - in.v[0]).cross(e2) + e1.cross(in.v[2] - in.v[0]);
+  const Vec3 nRate = (bigRate - bigRate.dot(n) * n) / twiceArea;
+  const double rho = p.density * in.exposure;
+  Vec3 total = Vec3::Zero();
+  // Translational circulation: lift -rho C_T (u.n)(|u|^2 n - (u.n) u)/|u|
+  // per unit area, perpendicular to u, u the piece's velocity relative to
+  // the wind here (eq. (5.4)'s C_T term).
+  const Vec3 uc = in.pieceVelocity - in.wind;
+  const double ucSpeed = uc.norm();
+  if (ucSpeed > kStill) {
+    const double ucn = uc.dot(n);
+    total -=
+        (rho * p.translationalLift * area * ucn / ucSpeed) * (ucSpeed * ucSpeed * n - ucn * uc);
+  }
+  // Rotational circulation: 1/2 rho C_R chord (omega x u) per unit area,
+  // omega the part of the piece's spin that turns this face (eq. (5.4)'s C_R
+  // term).
+  const Vec3 turning = in.pieceSpin - in.pieceSpin.dot(n) * n;
+  total += (0.5 * rho * p.rotationalLift * in.chord * area) * turning.cross(uc);
+  // Added mass m: the air's momentum m (u.n) n changes with the normal, and
+  // a changing wind carries m along (d/dt of dT/dv, T = 1/2 m (u.n)^2).
+  const double m = rho * p.addedMass * in.chord * area;
+  total -= m * (u.dot(nRate) * n + un * nRate);
+  total += m * in.windRate.dot(n) * n;
+  for (Vec3& f : out) f = total / 3.0;
+  // dT/dx through the normal: the Munk moment, m (u.n) (dn/dx_a)^T u.
+  const Vec3 f1 = (m * un / twiceArea) * e2.cross(ut);
+  const Vec3 f2 = (m * un / twiceArea) * ut.cross(e1);
+  out[0] -= f1 + f2;
+  out[1] += f1;
+  out[2] += f2;
+  return out;
+}
+
+struct AirModel::Impl {
+  AirParams params;
+  WindField wind;
+  std::vector<std::array<int, 3>> triangles;
+  Pieces pieces;
+  std::size_t vertexCount = 0;
+  double h = 0.0;
+  std::vector<AirTriangleFrame> frames;
+  std::vector<Vec3> forces;
+  std::vector<double> exposure;
+  ShelterCaster shelter;
+
+  Impl(const AirParams& p, const std::vector<std::array<int, 3>>& tris,
+       const std::vector<Vec2>& pattern, std::size_t nv)
+      : params(p),
+        wind(p),
+        triangles(tris),
+        pieces(findPieces(tris, pattern, nv)),
+        vertexCount(nv) {}
+  double chordOf(std::size_t t) const {
+    return pieces.chord[static_cast<std::size_t>(pieces.of[t])];
+  }
+};
+
+AirModel::AirModel(const AirParams& params, const std::vector<std::array<int, 3>>& triangles,
+                   const std::vector<Vec2>& pattern, std::size_t vertexCount)
+    : impl_(std::make_unique<Impl>(params, triangles, pattern, vertexCount)) {}
+AirModel::~AirModel() = default;
+AirModel::AirModel(AirModel&&) noexcept = default;
+AirModel& AirModel::operator=(AirModel&&) noexcept = default;
+
+void AirModel::beginStep(const std::vector<Vec3>& x, const std::vector<Vec3>& v, double t0,
+                         double t1, const ColliderSet* colliders) {
+  Impl& m = *impl_;
+  const AirParams& p = m.params;
+  m.h = t1 - t0;
+  const std::size_t nt = m.triangles.size();
+  m.frames.assign(nt, AirTriangleFrame{});
+  m.forces.assign(m.vertexCount, Vec3::Zero());
+  m.exposure.assign(nt, 1.0);
+  std::vector<Vec3> centroid(nt), relative(nt), windEnd(nt), windStart(nt);
+  for (std::size_t t = 0; t < nt; ++t) {
+    const auto& tri = m.triangles[t];
+    const Vec3 c = (x[static_cast<std::size_t>(tri[0])] + x[static_cast<std::size_t>(tri[1])] +
+                    x[static_cast<std::size_t>(tri[2])]) /
+                   3.0;
+    const Vec3 vbar = (v[static_cast<std::size_t>(tri[0])] + v[static_cast<std::size_t>(tri[1])] +
+                       v[static_cast<std::size_t>(tri[2])]) /
+                      3.0;
+    centroid[t] = c;
+    windEnd[t] = m.wind.at(c, t1);
+    windStart[t] = m.wind.at(c, t0);
+    if (colliders != nullptr && colliders->size() > 0) {
+      // No flow through a wall: the wind's normal part fades to nothing at it.
+      const double reach = m.chordOf(t);
+      if (const auto wall = colliders->nearest(c, reach)) {
+        const double fade = 1.0 - std::clamp(wall->distance / reach, 0.0, 1.0);
+        for (Vec3* w : {&windEnd[t], &windStart[t]})
+          *w -= fade * w->dot(wall->normal) * wall->normal;
+      }
+    }
+    relative[t] = vbar - windEnd[t];
+  }
+  std::vector<Vec3> pieceVelocity, pieceSpin;
+  pieceMotion(m.triangles, m.pieces, x, v, pieceVelocity, pieceSpin);
+  if (p.shelter) {
+    m.shelter.build(x, m.triangles);
+    for (std::size_t t = 0; t < nt; ++t) {
+      const double speed = relative[t].norm();
+      if (!(speed > kStill)) continue;
+      // The air reaches the face from where the face moves to: upwind.
+      const double reach = m.chordOf(t);
+      const double hit = m.shelter.hitDistance(t, centroid[t], relative[t] / speed, reach);
+      m.exposure[t] = std::clamp(hit / reach, 0.0, 1.0);
+    }
+  }
+  for (std::size_t t = 0; t < nt; ++t) {
+    const auto& tri = m.triangles[t];
+    AirExplicitInput in;
+    for (std::size_t a = 0; a < 3; ++a) {
+      in.x[a] = x[static_cast<std::size_t>(tri[a])];
+      in.v[a] = v[static_cast<std::size_t>(tri[a])];
+    }
+    const Vec3 big = (in.x[1] - in.x[0]).cross(in.x[2] - in.x[0]);
+    const double twiceArea = big.norm();
+    AirTriangleFrame& f = m.frames[t];
+    f.centroidStart = centroid[t];
+    f.inertiaTarget = centroid[t] + m.h * (relative[t] + windEnd[t]);
+    f.wind = windEnd[t];
+    if (!(twiceArea > 0.0)) continue;
+    f.normal = big / twiceArea;
+    const double area = 0.5 * twiceArea;
+    const double speed = relative[t].norm();
+    const double sin2 = speed > kStill ? std::pow(relative[t].dot(f.normal) / speed, 2.0) : 1.0;
+    const double cd = p.dragTangential + (p.dragNormal - p.dragTangential) * sin2;
+    f.drag = 0.5 * p.density * area * cd * m.exposure[t];
+    f.addedMass = p.density * p.addedMass * m.chordOf(t) * area * m.exposure[t];
+    in.wind = windEnd[t];
+    in.windRate = (windEnd[t] - windStart[t]) / m.h;
+    in.chord = m.chordOf(t);
+    in.pieceVelocity = pieceVelocity[static_cast<std::size_t>(m.pieces.of[t])];
+    in.pieceSpin = pieceSpin[static_cast<std::size_t>(m.pieces.of[t])];
+    in.exposure = m.exposure[t];
+    const auto fs = airExplicitForces(p, in);
+    for (std::size_t a = 0; a < 3; ++a) m.forces[static_cast<std::size_t>(tri[a])] += fs[a];
+  }
+}
+
+const std::vector<AirTriangleFrame>& AirModel::frames() const { return impl_->frames; }
+const std::vector<Vec3>& AirModel::explicitForces() const { return impl_->forces; }
+const std::vector<double>& AirModel::exposure() const { return impl_->exposure; }
+double AirModel::chord(std::size_t triangle) const { return impl_->chordOf(triangle); }
+double AirModel::stepLength() const { return impl_->h; }
+const AirParams& AirModel::params() const { return impl_->params; }
+
+}  // namespace crumple::sim

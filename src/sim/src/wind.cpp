@@ -1,0 +1,100 @@
+// The wind field (sim/air.hpp, docs/AIR.md "Wind and gusts"): the mean
+// wind's keys and the gusts' random Fourier modes (Kraichnan 1970).
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "crumple/core/rng.hpp"
+#include "crumple/sim/air.hpp"
+
+namespace crumple::sim {
+
+namespace {
+
+// The gusts' wavenumbers span this ratio above the largest eddy's.
+constexpr double kGustBandwidth = 8.0;
+
+// A unit vector from two uniforms in [0, 1) (uniform on the sphere).
+Vec3 unitVector(double a, double b) {
+  const double z = 2.0 * a - 1.0;
+  const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+  const double phi = 2.0 * std::numbers::pi * b;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+}  // namespace
+
+WindField::WindField(const AirParams& params) : keys_(params.wind) {
+  std::stable_sort(keys_.begin(), keys_.end(),
+                   [](const WindKey& a, const WindKey& b) { return a.time < b.time; });
+  const GustParams& g = params.gusts;
+  if (!(g.speed > 0.0) || g.modes <= 0) return;
+  const CounterRng rng(g.seed, 0, RngPurpose::Gusts);
+  // Wavenumbers with density k^(-5/3) on [k0, kGustBandwidth k0], drawn by
+  // inverting its distribution: every mode then carries the same energy.
+  const double k0 = 2.0 * std::numbers::pi / g.lengthScale;
+  const double k1 = kGustBandwidth * k0;
+  const double p0 = std::pow(k0, -2.0 / 3.0), p1 = std::pow(k1, -2.0 / 3.0);
+  // Each mode's amplitude: the modes' mean squares add to speed^2.
+  const double amplitude = g.speed * std::sqrt(2.0 / static_cast<double>(g.modes));
+  modes_.reserve(static_cast<std::size_t>(g.modes));
+  for (int i = 0; i < g.modes; ++i) {
+    const auto base = static_cast<std::uint64_t>(i) * 8;
+    const double k = std::pow(p0 + rng.uniform(base) * (p1 - p0), -1.5);
+    const Vec3 dir = unitVector(rng.uniform(base + 1), rng.uniform(base + 2));
+    // Divergence-free: the amplitude is perpendicular to the wavevector.
+    Vec3 a = dir.cross(unitVector(rng.uniform(base + 3), rng.uniform(base + 4)));
+    if (a.norm() < 1e-6) a = dir.unitOrthogonal();
+    Mode m;
+    m.wavevector = k * dir;
+    m.amplitude = amplitude * a.normalized();
+    // Decorrelation: angular frequencies around 2 pi / timeScale.
+    m.frequency = 2.0 * std::numbers::pi / g.timeScale * (0.5 + rng.uniform(base + 5));
+    m.phase = 2.0 * std::numbers::pi * rng.uniform(base + 6);
+    modes_.push_back(m);
+  }
+}
+
+Vec3 WindField::mean(double t) const {
+  if (keys_.empty()) return Vec3::Zero();
+  if (t <= keys_.front().time) return keys_.front().velocity;
+  if (t >= keys_.back().time) return keys_.back().velocity;
+  const auto hi = std::upper_bound(keys_.begin(), keys_.end(), t,
+                                   [](double tt, const WindKey& k) { return tt < k.time; });
+  const auto lo = hi - 1;
+  const double span = hi->time - lo->time;
+  const double s = span > 0.0 ? (t - lo->time) / span : 1.0;
+  return (1.0 - s) * lo->velocity + s * hi->velocity;
+}
+
+Vec3 WindField::travel(double t) const {
+  // The integral of the piecewise-linear mean wind from 0 to t.
+  const auto integral = [this](double a, double b) {
+    // Trapezoids between the keys' times inside [a, b] (a <= b).
+    Vec3 sum = Vec3::Zero();
+    double t0 = a;
+    Vec3 w0 = mean(a);
+    for (const WindKey& k : keys_) {
+      if (k.time <= a) continue;
+      if (k.time >= b) break;
+      sum += 0.5 * (k.time - t0) * (w0 + k.velocity);
+      t0 = k.time;
+      w0 = k.velocity;
+    }
+    return Vec3(sum + 0.5 * (b - t0) * (w0 + mean(b)));
+  };
+  return t >= 0.0 ? integral(0.0, t) : Vec3(-integral(t, 0.0));
+}
+
+Vec3 WindField::at(const Vec3& x, double t) const {
+  const Vec3 w = mean(t);
+  if (modes_.empty()) return w;
+  // Taylor's hypothesis: the eddies travel with the mean wind.
+  const Vec3 carried = x - travel(t);
+  Vec3 gust = Vec3::Zero();
+  for (const Mode& m : modes_)
+    gust += m.amplitude * std::cos(m.wavevector.dot(carried) + m.frequency * t + m.phase);
+  return w + gust;
+}
+
+}  // namespace crumple::sim
