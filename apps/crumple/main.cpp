@@ -55,7 +55,8 @@ void addShotCommands(CLI::App& app, Args& a, Commands& c) {
     cmd->add_option(
         "--seed", a.seed,
         "override the scene's seed, 0 ... 2^63 - 1 (it places the crumpling model's singular "
-        "vertices; the elastic model draws no random numbers)");
+        "vertices, draws [air]'s gusts and the soundtrack's variations and seeds the path "
+        "tracer's samples)");
     cmd->add_option("--threads", a.threads, "worker threads; results are identical for any count")
         ->check(CLI::Range(1, 256));
     cmd->add_option("--checkpoint-every", a.checkpointEvery,

@@ -53,6 +53,8 @@ ShotPlan planShot(const io::SceneSpec& scene, const ShotOptions& options) {
   m.fps = scene.fps;
   m.substeps = scene.substeps;
   m.seed = plan.seed;
+  // The gusts are drawn from the shot's seed (--seed overrides the scene's).
+  if (m.sim.air) m.sim.air->gusts.seed = plan.seed;
   m.tearing = scene.tearing;
   m.projectionProbe = options.projectionProbe;
   plan.soundEvents = scene.soundEvents;

@@ -213,6 +213,7 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
   j.key("contacts").value(!scene.colliders.empty());
   j.key("self_contact").value(r.selfContactSteps > 0);
   j.key("tearing").value(r.tearingOn);
+  j.key("air").value(scene.sim.air.has_value());
   j.key("sound").value(r.soundOn);
   j.key("render_osmesa").value(r.framesRendered > 0 && r.renderBackend == "osmesa");
   j.key("render_embree").value(r.framesRendered > 0 && r.renderBackend == "embree");

@@ -59,7 +59,7 @@ SceneSpec SceneParser::parse() {
   parseSound(root.subTable("sound"));
   parseOutput(root.subTable("output"));
   parseSim(root.subTable("sim"));
-  // After [sim] (whose struct holds the air) and [scene] (the gusts' seed).
+  // After [sim], whose struct holds the air.
   parseAir(root.subTable("air"));
   parseModel(root.subTable("model"));
   return std::move(spec_);

@@ -70,7 +70,6 @@ void SceneParser::parseAir(const toml::table* table) {
       r.fail("gust_modes", "must be in [1, " + std::to_string(kMaxGustModes) + "]");
     g.modes = static_cast<int>(*n);
   }
-  g.seed = spec_.seed;
   if (auto v = r.number("drag_normal"))
     air.dragNormal = inRange("drag_normal", *v, 0.0, kMaxCoefficient);
   if (auto v = r.number("drag_tangential"))

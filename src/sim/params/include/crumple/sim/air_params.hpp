@@ -29,7 +29,7 @@ struct GustParams {
   double lengthScale = 0.5;  // m, the largest eddy
   double timeScale = 1.0;    // s
   int modes = 32;
-  std::uint64_t seed = 0;  // the shot's seed ([scene] seed)
+  std::uint64_t seed = 0;  // the shot's seed ([scene] seed or --seed; the shot sets it)
   bool operator==(const GustParams&) const = default;
 };
 
