@@ -15,6 +15,7 @@
 
 #include "crumple/cache/pcache.hpp"
 #include "crumple/cache/pcache_contacts.hpp"
+#include "crumple/cache/pcache_sound.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "sample_shot.hpp"
 
@@ -171,7 +172,8 @@ TEST(AirSamples, FallStripTumblesAndGlidesSideways) {
 
 TEST(AirSamples, FallFlutterSwingsWithoutTurningOver) {
   TempDir dir;
-  const Flight f = flightOf(simulateSample("fall-flutter", dir));
+  const std::string cachePath = simulateSample("fall-flutter", dir);
+  const Flight f = flightOf(cachePath);
   ASSERT_GE(f.landed, 0) << "the sheet lands within the shot";
   double tilt = 0.0;
   for (const Vec3& n : f.normal)
@@ -187,10 +189,27 @@ TEST(AirSamples, FallFlutterSwingsWithoutTurningOver) {
     if (lastSign != 0.0 && sign != lastSign) ++reversals;
     lastSign = sign;
   }
-  std::printf("[ measure ] fall-flutter: largest tilt %.1f deg, %d lateral reversals in %.2f s\n",
-              tilt, reversals, f.time.back());
+  // Its sound: the flaps of the sheet flexing as it swings, in the air, and
+  // the clac and slide of its landing.
+  const cache::CacheReader reader(cachePath);
+  ASSERT_TRUE(cache::decodeSoundSetup(reader.header().extensions).has_value()) << "[sound]";
+  int flaps = 0, landing = 0;
+  for (std::size_t k = 0; k < reader.frameCount(); ++k) {
+    const auto events = cache::decodeSoundEvents(reader.readFrame(k).extensions);
+    if (!events) continue;  // a frame without events
+    for (const auto& e : *events) {
+      if (static_cast<int>(k) < f.landed && e.kind == sound::EventKind::Crumpling) ++flaps;
+      if (static_cast<int>(k) >= f.landed) ++landing;
+    }
+  }
+  std::printf(
+      "[ measure ] fall-flutter: largest tilt %.1f deg, %d lateral reversals in %.2f s; %d "
+      "crumpling events in the air, %d from the landing on\n",
+      tilt, reversals, f.time.back(), flaps, landing);
   EXPECT_LT(tilt, 90.0);
   EXPECT_GE(reversals, 2);
+  EXPECT_GE(flaps, reversals);
+  EXPECT_GT(landing, 0);
 }
 
 namespace {

@@ -205,3 +205,14 @@ TEST(Resume, TheCrumplingModelsSummaryIsTheUninterruptedRuns) {
 TEST(Resume, ACrumplingModelResumedAtItsLastFrameKeepsTheSummary) {
   expectCrumplingResumeKeepsTheSummary(45);
 }
+
+TEST(Resume, AGustyAirShotResumesToTheSameBytes) {
+  // The air keeps no state between steps (docs/AIR.md): the wind is a
+  // function of place and time, the gusts of the seed.
+  const TempDir tmp;
+  const auto scene = io::loadScene(io::resolveScenePath(sourcePath("samples/desk-draught")));
+  ASSERT_TRUE(scene.sim.air.has_value());
+  // Checkpoints at frames 13 and 26: the resume simulates 27-34 again, in the gust.
+  expectResumedSummaryIsTheWholeOne(scene, tmp / "out", 13, false,
+                                    pipeline::FrameRange{scene.frameStart, 34});
+}

@@ -215,6 +215,9 @@ TEST(AirModel, AFaceBehindAnotherLayerIsSheltered) {
   EXPECT_DOUBLE_EQ(air.exposure()[lower], 1.0);
   EXPECT_NEAR(air.exposure()[upper], 0.01 / air.chord(upper), 1e-9);
   EXPECT_LT(air.frames()[upper].drag, 0.5 * air.frames()[lower].drag);
+  // Each layer has one side open and one 1 cm from the other layer.
+  EXPECT_NEAR(air.openness()[lower], 0.5 * (1.0 + 0.01 / air.chord(lower)), 1e-9);
+  EXPECT_NEAR(air.openness()[upper], 0.5 * (1.0 + 0.01 / air.chord(upper)), 1e-9);
 }
 
 TEST(AirSheet, AFlatSheetFallsAtTheQuasiSteadyTerminalSpeed) {

@@ -56,6 +56,7 @@ struct Case {
   Bounds elastic, hybrid;
   std::string hybridKeys = {};  // more [model] keys for the crumpling model
   int hybridShortLast = 0;      // the crumpling model's short clip, when longer (0: shortLast)
+  std::string moreTables = {};  // more tables for both models (an [air], docs/AIR.md)
 };
 
 bool fullSuite() {
@@ -88,12 +89,20 @@ std::vector<Case> cases() {
   // a strain limit that kept them from passing further left 33 % from frame
   // 44 on (docs/CRUMPLING.md "A lagging handle's way back").
   c.push_back({"Twist4Pi", "twist-4pi", 40, 0, false, 150, 600, twistElastic, kHybrid, "", 120});
+  // The same twist in a gusty wind across the strip (docs/AIR.md): drag,
+  // lift and added mass on a sheet whose layers pass through each other.
+  c.push_back({"Twist4PiAir", "twist-4pi", 40, 0, false, 150, 600, twistElastic, kHybrid, "", 120,
+               "[air]\nwind = [0, 0, 2]\ngust_speed = 0.8\ngust_length = 0.2\n"});
   // A pin that moves 5 cm within one substep drags its neighbours' edges:
   // ~30 % strain for a few substeps on the elastic model.
   Bounds jumpElastic = kElastic;
   jumpElastic.cMean = 0.02;
   jumpElastic.maxStrain = 0.50;
   c.push_back({"HandleJump", "handle-jump", 14, 0, false, 150, 600, jumpElastic, kHybrid});
+  // The jump in a 5 m/s gusty wind: the jump's 5 cm in a substep is a speed
+  // of metres per second, a stiff drag for the implicit step.
+  c.push_back({"HandleJumpAir", "handle-jump", 14, 0, false, 150, 600, jumpElastic, kHybrid, "", 0,
+               "[air]\nwind = [5, 0, 1]\ngust_speed = 1.5\ngust_length = 0.1\n"});
   c.push_back({"SamePoint", "same-point", 30, 0, false, 120, 300, kElastic, kHybrid});
   // Four times the sheet's reach: the handle lags its node by up to 30 cm
   // (the animation's excess), the sheet stays within the reach's strain.
@@ -223,6 +232,7 @@ fs::path prepareScene(const Case& c, bool hybrid, const fs::path& dir) {
     toml = std::regex_replace(toml, std::regex("\nsubsteps = [0-9]+\n"),
                               "\nsubsteps = " + std::to_string(c.substeps) + "\n");
   if (hybrid) toml += "\n[model]\ntype = \"hybrid\"\nmax_edge_strain = 0.02\n" + c.hybridKeys;
+  if (!c.moreTables.empty()) toml += "\n" + c.moreTables;
   writeFile(dir / "scene.toml", toml);
   return dir;
 }

@@ -184,7 +184,7 @@ std::array<Vec3, 3> airExplicitForces(const AirParams& p, const AirExplicitInput
   const Vec3 e1 = in.x[1] - in.x[0], e2 = in.x[2] - in.x[0];
   const Vec3 big = e1.cross(e2);
   const double twiceArea = big.norm();
-  if (!(twiceArea > 0.0) || !(in.exposure > 0.0)) return out;
+  if (!(twiceArea > 0.0)) return out;
   const Vec3 n = big / twiceArea;
   const double area = 0.5 * twiceArea;
   const Vec3 u = (in.v[0] + in.v[1] + in.v[2]) / 3.0 - in.wind;
@@ -193,7 +193,7 @@ std::array<Vec3, 3> airExplicitForces(const AirParams& p, const AirExplicitInput
   // The normal's rate: the tangential part of d(e1 x e2)/dt over |e1 x e2|.
   const Vec3 bigRate = (in.v[1] - in.v[0]).cross(e2) + e1.cross(in.v[2] - in.v[0]);
   const Vec3 nRate = (bigRate - bigRate.dot(n) * n) / twiceArea;
-  const double rho = p.density * in.exposure;
+  const double rho = p.density * in.exposure;  // the flow's forces
   Vec3 total = Vec3::Zero();
   // Translational circulation: lift -rho C_T (u.n)(|u|^2 n - (u.n) u)/|u|
   // per unit area, perpendicular to u, u the piece's velocity relative to
@@ -212,7 +212,7 @@ std::array<Vec3, 3> airExplicitForces(const AirParams& p, const AirExplicitInput
   total += (0.5 * rho * p.rotationalLift * in.chord * area) * turning.cross(uc);
   // Added mass m: the air's momentum m (u.n) n changes with the normal, and
   // a changing wind carries m along (d/dt of dT/dv, T = 1/2 m (u.n)^2).
-  const double m = rho * p.addedMass * in.chord * area;
+  const double m = p.density * in.openness * p.addedMass * in.chord * area;
   total -= m * (u.dot(nRate) * n + un * nRate);
   total += m * in.windRate.dot(n) * n;
   for (Vec3& f : out) f = total / 3.0;
@@ -234,7 +234,7 @@ struct AirModel::Impl {
   double h = 0.0;
   std::vector<AirTriangleFrame> frames;
   std::vector<Vec3> forces;
-  std::vector<double> exposure;
+  std::vector<double> exposure, openness;
   ShelterCaster shelter;
 
   Impl(const AirParams& p, const std::vector<std::array<int, 3>>& tris,
@@ -265,6 +265,7 @@ void AirModel::beginStep(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
   m.frames.assign(nt, AirTriangleFrame{});
   m.forces.assign(m.vertexCount, Vec3::Zero());
   m.exposure.assign(nt, 1.0);
+  m.openness.assign(nt, 1.0);
   std::vector<Vec3> centroid(nt), relative(nt), windEnd(nt), windStart(nt);
   for (std::size_t t = 0; t < nt; ++t) {
     const auto& tri = m.triangles[t];
@@ -293,12 +294,23 @@ void AirModel::beginStep(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
   if (p.shelter) {
     m.shelter.build(x, m.triangles);
     for (std::size_t t = 0; t < nt; ++t) {
-      const double speed = relative[t].norm();
-      if (!(speed > kStill)) continue;
-      // The air reaches the face from where the face moves to: upwind.
       const double reach = m.chordOf(t);
-      const double hit = m.shelter.hitDistance(t, centroid[t], relative[t] / speed, reach);
-      m.exposure[t] = std::clamp(hit / reach, 0.0, 1.0);
+      // The flow reaches the face from where the face moves to: upwind.
+      if (const double speed = relative[t].norm(); speed > kStill)
+        m.exposure[t] = std::clamp(
+            m.shelter.hitDistance(t, centroid[t], relative[t] / speed, reach) / reach, 0.0, 1.0);
+      // The air it pushes aside is on both its sides: how open each is.
+      const auto& tri = m.triangles[t];
+      const Vec3 big =
+          (x[static_cast<std::size_t>(tri[1])] - x[static_cast<std::size_t>(tri[0])])
+              .cross(x[static_cast<std::size_t>(tri[2])] - x[static_cast<std::size_t>(tri[0])]);
+      if (const double twiceArea = big.norm(); twiceArea > 0.0) {
+        const Vec3 n = big / twiceArea;
+        double open = 0.0;
+        for (const Vec3& side : {n, Vec3(-n)})
+          open += std::clamp(m.shelter.hitDistance(t, centroid[t], side, reach) / reach, 0.0, 1.0);
+        m.openness[t] = 0.5 * open;
+      }
     }
   }
   for (std::size_t t = 0; t < nt; ++t) {
@@ -321,13 +333,14 @@ void AirModel::beginStep(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
     const double sin2 = speed > kStill ? std::pow(relative[t].dot(f.normal) / speed, 2.0) : 1.0;
     const double cd = p.dragTangential + (p.dragNormal - p.dragTangential) * sin2;
     f.drag = 0.5 * p.density * area * cd * m.exposure[t];
-    f.addedMass = p.density * p.addedMass * m.chordOf(t) * area * m.exposure[t];
+    f.addedMass = p.density * p.addedMass * m.chordOf(t) * area * m.openness[t];
     in.wind = windEnd[t];
     in.windRate = (windEnd[t] - windStart[t]) / m.h;
     in.chord = m.chordOf(t);
     in.pieceVelocity = pieceVelocity[static_cast<std::size_t>(m.pieces.of[t])];
     in.pieceSpin = pieceSpin[static_cast<std::size_t>(m.pieces.of[t])];
     in.exposure = m.exposure[t];
+    in.openness = m.openness[t];
     const auto fs = airExplicitForces(p, in);
     for (std::size_t a = 0; a < 3; ++a) m.forces[static_cast<std::size_t>(tri[a])] += fs[a];
   }
@@ -336,6 +349,7 @@ void AirModel::beginStep(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
 const std::vector<AirTriangleFrame>& AirModel::frames() const { return impl_->frames; }
 const std::vector<Vec3>& AirModel::explicitForces() const { return impl_->forces; }
 const std::vector<double>& AirModel::exposure() const { return impl_->exposure; }
+const std::vector<double>& AirModel::openness() const { return impl_->openness; }
 double AirModel::chord(std::size_t triangle) const { return impl_->chordOf(triangle); }
 double AirModel::stepLength() const { return impl_->h; }
 const AirParams& AirModel::params() const { return impl_->params; }

@@ -58,7 +58,7 @@ struct AirTriangleFrame {
   Vec3 inertiaTarget = Vec3::Zero();  // centroid at x_n + h v_n
   Vec3 wind = Vec3::Zero();           // at the centroid, end of the step
   double drag = 0.0;                  // 1/2 rho A C_D(alpha_n) times the exposure (kg/m)
-  double addedMass = 0.0;             // rho addedMass chord A times the exposure (kg)
+  double addedMass = 0.0;             // rho addedMass chord A times the openness (kg)
 };
 
 // The implicit part of one triangle's air at positions (x0, x1, x2) over a
@@ -77,7 +77,8 @@ double airTriangleEnergy(const AirTriangleFrame& frame, double h, const Vec3& x0
 // and the added mass's forces as the triangle turns (d/dt of the air's
 // momentum through the normal, and the derivative of its kinetic energy by
 // the positions: the Munk moment), plus the added mass carried along by a
-// changing wind (windRate = dw/dt). exposure scales them as it scales drag.
+// changing wind (windRate = dw/dt). exposure scales the lift as it scales
+// drag, openness the added mass's forces as it scales its inertia.
 struct AirExplicitInput {
   std::array<Vec3, 3> x, v;
   Vec3 wind = Vec3::Zero();
@@ -86,6 +87,7 @@ struct AirExplicitInput {
   Vec3 pieceSpin = Vec3::Zero();      // the piece's angular velocity (rad/s)
   double chord = 0.0;                 // m
   double exposure = 1.0;              // in [0, 1]
+  double openness = 1.0;              // in [0, 1]
 };
 std::array<Vec3, 3> airExplicitForces(const AirParams& params, const AirExplicitInput& in);
 
@@ -109,8 +111,13 @@ class AirModel {
   const std::vector<AirTriangleFrame>& frames() const;
   // Per vertex (N), summed over its triangles in triangle order.
   const std::vector<Vec3>& explicitForces() const;
-  // Per triangle, in [0, 1]: 1 fully exposed, 0 sheltered.
+  // Per triangle, in [0, 1] (docs/AIR.md "Sheltering"): how much of the
+  // flow reaches it (its upwind ray's free length over the chord), which
+  // scales drag and lift; and how open its two sides are (the mean of its
+  // rays' free lengths along +n and -n over the chord), which scales its
+  // added mass: the air between two layers or inside a ball moves with it.
   const std::vector<double>& exposure() const;
+  const std::vector<double>& openness() const;
   double chord(std::size_t triangle) const;
   double stepLength() const;
   const AirParams& params() const;

@@ -44,7 +44,7 @@ struct AirParams {
   // Drag along the relative velocity: C_D(alpha) = dragTangential cos^2 alpha
   // + dragNormal sin^2 alpha, alpha the angle of attack (Andersen et al.'s
   // A - B cos 2 alpha). dragNormal: a square flat plate broadside (Hoerner
-  // 1965, Fluid-Dynamic Drag, 3-16); dragTangential: Andersen et al.'s ratio
+  // 1965, Fluid-Dynamic Drag); dragTangential: Andersen et al.'s ratio
   // C_D(0) / C_D(pi/2) = 0.4 / 2.4 applied to it.
   double dragNormal = 1.17;
   double dragTangential = 0.195;
