@@ -17,7 +17,7 @@
 namespace crumple::pipeline {
 namespace {
 
-constexpr std::uint32_t kCheckpointVersion = 6;
+constexpr std::uint32_t kCheckpointVersion = 7;
 constexpr char kMagic[9] = "CRUMPCKP";
 
 std::uint64_t sceneHash(const io::SceneSpec& scene) {
@@ -163,6 +163,7 @@ void saveReport(StateWriter& w, const ShotReport& r) {
   w.i32(r.maxHandleLagVertex);
   w.f64(r.contactMs);
   w.f64(r.selfContactMs);
+  w.f64(r.airMs);
   w.i64(r.selfContactSteps);
   w.f64(r.maxContactDepth);
   w.i32(r.maxContactDepthFrame);
@@ -232,6 +233,7 @@ void restoreReport(StateReader& in, ShotReport& r, std::size_t handles) {
   r.maxHandleLagVertex = in.i32();
   r.contactMs = in.f64();
   r.selfContactMs = in.f64();
+  r.airMs = in.f64();
   r.selfContactSteps = in.i64();
   r.maxContactDepth = in.f64();
   r.maxContactDepthFrame = in.i32();

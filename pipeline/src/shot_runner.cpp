@@ -71,6 +71,7 @@ ShotRunner::ShotRunner(const io::SceneSpec& scene, const ShotOptions& options)
   context.contacts = contactOptionsOf(scene, *colliders_);
   context.contactsOn = !colliders_->empty() || context.contacts.self != sim::SelfContactMode::Off;
   report_.contactsOn = context.contactsOn;
+  report_.airOn = context.sim.air.has_value();
   report_.selfContactMode = context.contacts.self == sim::SelfContactMode::On    ? "on"
                             : context.contacts.self == sim::SelfContactMode::Off ? "off"
                                                                                  : "auto";
@@ -218,6 +219,7 @@ void ShotRunner::step(int frame) {
   r.substeps += s.substeps;
   r.contactMs += s.contactMs;
   r.selfContactMs += s.selfContactMs;
+  r.airMs += s.airMs;
   r.selfContactSteps += s.selfContactSteps;
   for (const auto& [name, ms] : s.stageMs) {
     r.stages[name].totalMs += ms;

@@ -119,11 +119,26 @@ void ShotRunner::writeSummary() const {
   }
 }
 
-double ShotReport::contactShareOfStep() const {
+namespace {
+
+// The simulation step's stages (ms over the shot).
+double stepMs(const ShotReport& r) {
   double step = 0.0;
   for (const char* name : {"elastic", "geometric", "cones", "rebuild", "isometry", "contacts"})
-    if (const auto it = stages.find(name); it != stages.end()) step += it->second.totalMs;
+    if (const auto it = r.stages.find(name); it != r.stages.end()) step += it->second.totalMs;
+  return step;
+}
+
+}  // namespace
+
+double ShotReport::contactShareOfStep() const {
+  const double step = stepMs(*this);
   return step > 0.0 ? (contactMs + selfContactMs) / step : 0.0;
+}
+
+double ShotReport::airShareOfStep() const {
+  const double step = stepMs(*this);
+  return step > 0.0 ? airMs / step : 0.0;
 }
 
 std::string summaryText(const ShotReport& r) {
@@ -152,6 +167,11 @@ std::string summaryText(const ShotReport& r) {
                   r.contactMs / frames, r.selfContactMs / frames, r.selfContactMode.c_str(),
                   r.selfContactSteps, 100.0 * r.contactShareOfStep(), r.maxContactDepth,
                   r.maxContactDepthFrame);
+    out += line;
+  }
+  if (r.airOn) {
+    std::snprintf(line, sizeof line, "  air      %.2f ms/frame: %.1f %% of the step\n",
+                  r.airMs / std::max(1, r.framesSimulated - 1), 100.0 * r.airShareOfStep());
     out += line;
   }
   if (r.tearingOn) {
@@ -213,7 +233,7 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
   j.key("contacts").value(!scene.colliders.empty());
   j.key("self_contact").value(r.selfContactSteps > 0);
   j.key("tearing").value(r.tearingOn);
-  j.key("air").value(scene.sim.air.has_value());
+  j.key("air").value(r.airOn);
   j.key("sound").value(r.soundOn);
   j.key("render_osmesa").value(r.framesRendered > 0 && r.renderBackend == "osmesa");
   j.key("render_embree").value(r.framesRendered > 0 && r.renderBackend == "embree");
@@ -237,6 +257,13 @@ std::string summaryJson(const io::SceneSpec& scene, const ShotReport& r) {
         .value(static_cast<double>(r.contactSamples) / std::max(1, r.framesSimulated));
     j.key("max_depth_thicknesses").value(r.maxContactDepth);
     j.key("max_depth_frame").value(r.maxContactDepthFrame);
+    j.endObject();
+  }
+  if (r.airOn) {
+    // What the air's terms cost in the elastic step (docs/AIR.md "Cost").
+    j.key("air").beginObject();
+    j.key("ms_per_frame").value(r.airMs / std::max(1, r.framesSimulated - 1));
+    j.key("share_of_step").value(r.airShareOfStep());
     j.endObject();
   }
   if (r.soundOn) {

@@ -136,6 +136,7 @@ FrameStats CrumplingModel::advance(int frame, const sim::PinFunction& pins) {
   out.selfContactDropped = stats.elastic.selfContactDropped;
   out.contactMs = stats.elastic.contactMs + stats.ms.contacts;
   out.selfContactMs = stats.elastic.selfContactMs + stats.ms.selfContacts;
+  out.airMs = stats.elastic.airMs;
   out.selfContactSteps = stats.elastic.selfContactSteps;
   out.stageMs = {{"elastic", stats.ms.elastic},   {"geometric", stats.ms.geometric},
                  {"cones", stats.ms.cones},       {"rebuild", stats.ms.rebuild},

@@ -47,6 +47,7 @@ FrameStats ElasticModel::advance(int frame, const sim::PinFunction& pins) {
       out.halvings += stats.halvings;
       out.contactMs += stats.contactMs;
       out.selfContactMs += stats.selfContactMs;
+      out.airMs += stats.airMs;
       out.selfContactSteps += stats.selfContactSteps;
       out.newtonRetried += stats.newtonRetried;
       out.selfContactDropped += stats.selfContactDropped;

@@ -82,6 +82,7 @@ void accumulate(HybridStepStats& total, const HybridStepStats& s) {
   }
   total.elastic.contactMs += s.elastic.contactMs;
   total.elastic.selfContactMs += s.elastic.selfContactMs;
+  total.elastic.airMs += s.elastic.airMs;
   total.elastic.selfContactSteps += s.elastic.selfContactSteps;
   total.coneSegments = s.coneSegments;
   total.topologyChanged = total.topologyChanged || s.topologyChanged;

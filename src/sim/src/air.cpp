@@ -10,6 +10,7 @@
 
 #include "air_shelter.hpp"
 #include "crumple/sim/colliders.hpp"
+#include "crumple/sim/self_contact.hpp"
 
 namespace crumple::sim {
 
@@ -18,6 +19,9 @@ namespace {
 // Below this relative speed (m/s) the angle of attack is undefined and the
 // lift terms vanish.
 constexpr double kStill = 1e-9;
+// Sheltering runs when the sheet's normals spread more than this from their
+// mean (rad, 60 degrees: ContactOptions::foldSpread's default).
+constexpr double kShelterSpread = 1.0471975511965976;
 
 // The connected pieces of the sheet: which one each triangle is in, and
 // each one's chord, twice its pattern area over its perimeter (a strip's
@@ -171,12 +175,20 @@ double airTriangleEnergy(const AirTriangleFrame& f, double h, const Vec3& x0, co
     for (int a = 0; a < 3; ++a) gradient->segment<3>(3 * a) = gc / 3.0;
   }
   if (hessian) {
-    Mat3 hc = (f.addedMass / h2) * f.normal * f.normal.transpose();
-    if (speed > 0.0) hc += (f.drag / h) * (speed * Mat3::Identity() + u * u.transpose() / speed);
+    const Mat3 hc = airCentroidHessian(f, h, x0, x1, x2) / 9.0;
     for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) hessian->block<3, 3>(3 * a, 3 * b) = hc / 9.0;
+      for (int b = 0; b < 3; ++b) hessian->block<3, 3>(3 * a, 3 * b) = hc;
   }
   return energy;
+}
+
+Mat3 airCentroidHessian(const AirTriangleFrame& f, double h, const Vec3& x0, const Vec3& x1,
+                        const Vec3& x2) {
+  const Vec3 u = ((x0 + x1 + x2) / 3.0 - f.centroidStart) / h - f.wind;
+  const double speed = u.norm();
+  Mat3 hc = (f.addedMass / (h * h)) * f.normal * f.normal.transpose();
+  if (speed > 0.0) hc += (f.drag / h) * (speed * Mat3::Identity() + u * u.transpose() / speed);
+  return hc;
 }
 
 std::array<Vec3, 3> airExplicitForces(const AirParams& p, const AirExplicitInput& in) {
@@ -291,7 +303,10 @@ void AirModel::beginStep(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
   }
   std::vector<Vec3> pieceVelocity, pieceSpin;
   pieceMotion(m.triangles, m.pieces, x, v, pieceVelocity, pieceSpin);
-  if (p.shelter) {
+  // Only a folded sheet has parts that can stand in each other's air (the
+  // self-contact gate, sim/self_contact.hpp): a flat or gently curved one
+  // casts no rays.
+  if (p.shelter && sheetIsFolded(m.triangles, x, kShelterSpread)) {
     m.shelter.build(x, m.triangles);
     for (std::size_t t = 0; t < nt; ++t) {
       const double reach = m.chordOf(t);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <stdexcept>
 
 namespace crumple::sim {
 
@@ -102,10 +103,13 @@ double ShelterCaster::hitDistance(std::size_t self, const Vec3& origin, const Ve
   const Vec3 inv = direction.cwiseInverse();
   const auto& mine = ids_[self];
   double best = maxDistance;
-  std::vector<int> stack{0};
-  while (!stack.empty()) {
-    const Node& node = nodes_[static_cast<std::size_t>(stack.back())];
-    stack.pop_back();
+  // A median-split tree over n triangles is about log2(n / kLeafSize) deep:
+  // 64 entries hold any mesh that fits in memory.
+  std::array<int, 64> stack{};
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[static_cast<std::size_t>(stack[static_cast<std::size_t>(--top)])];
     if (!(enterBox(node.box, origin, inv, best) < best)) continue;
     if (node.left < 0) {
       for (int i = node.first; i < node.first + node.count; ++i) {
@@ -119,8 +123,10 @@ double ShelterCaster::hitDistance(std::size_t self, const Vec3& origin, const Ve
       }
       continue;
     }
-    stack.push_back(node.left);
-    stack.push_back(node.right);
+    if (top + 2 > static_cast<int>(stack.size()))
+      throw std::length_error("ShelterCaster: too deep");
+    stack[static_cast<std::size_t>(top++)] = node.left;
+    stack[static_cast<std::size_t>(top++)] = node.right;
   }
   return best;
 }

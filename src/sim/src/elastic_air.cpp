@@ -21,15 +21,18 @@ double ElasticSheet::Impl::airEnergy(const std::vector<Vec3>& xs, double h) cons
   return e;
 }
 
-void ElasticSheet::Impl::addAirGradient(const std::vector<Vec3>& xs, double h, VecX& out) const {
+void ElasticSheet::Impl::addAirGradient(const std::vector<Vec3>& xs, double h, VecX& out) {
   const auto& frames = air->frames();
   const auto& forces = air->explicitForces();
+  airHess.resize(triangles.size());
   Vec9 g;
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     const auto& tri = triangles[t];
-    airTriangleEnergy(frames[t], h, xs[static_cast<std::size_t>(tri[0])],
-                      xs[static_cast<std::size_t>(tri[1])], xs[static_cast<std::size_t>(tri[2])],
-                      &g);
+    const Vec3& x0 = xs[static_cast<std::size_t>(tri[0])];
+    const Vec3& x1 = xs[static_cast<std::size_t>(tri[1])];
+    const Vec3& x2 = xs[static_cast<std::size_t>(tri[2])];
+    airTriangleEnergy(frames[t], h, x0, x1, x2, &g);
+    airHess[t] = airCentroidHessian(frames[t], h, x0, x1, x2) / 9.0;
     for (std::size_t a = 0; a < 3; ++a) {
       const int fi = freeIndex[static_cast<std::size_t>(tri[a])];
       if (fi >= 0) out.segment<3>(3 * fi) += g.segment<3>(3 * static_cast<int>(a));
@@ -39,18 +42,19 @@ void ElasticSheet::Impl::addAirGradient(const std::vector<Vec3>& xs, double h, V
     if (const int fi = freeIndex[i]; fi >= 0) out.segment<3>(3 * fi) -= forces[i];
 }
 
-void ElasticSheet::Impl::addAirHessian(const std::vector<Vec3>& xs, double h,
-                                       double* values) const {
-  const auto& frames = air->frames();
-  Mat9 block;
+void ElasticSheet::Impl::scatterTrianglesWithAir(double dampScale, double* values) const {
+  // airTriangleEnergy's Hessian is one 3 x 3 block repeated over the
+  // vertex pairs: added to the membrane's before the one scatter.
+  const bool damped = params.stiffnessDamping > 0.0;
   for (std::size_t t = 0; t < triangles.size(); ++t) {
-    const auto& tri = triangles[t];
-    airTriangleEnergy(frames[t], h, xs[static_cast<std::size_t>(tri[0])],
-                      xs[static_cast<std::size_t>(tri[1])], xs[static_cast<std::size_t>(tri[2])],
-                      nullptr, &block);
+    Mat9 block = triHess[t];
+    if (damped) block += dampScale * triDamp[t];
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) block.block<3, 3>(3 * a, 3 * b) += airHess[t];
     const int* off = triOffset.data() + 81 * t;
+    const double* bv = block.data();
     for (int i = 0; i < 81; ++i)
-      if (off[i] >= 0) values[off[i]] += block.data()[i];
+      if (off[i] >= 0) values[off[i]] += bv[i];
   }
 }
 

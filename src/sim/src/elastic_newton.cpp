@@ -170,7 +170,11 @@ bool ElasticSheet::Impl::newtonGradient(NewtonState& s, std::string& why) {
       if (fi >= 0) s.gradV.segment<3>(3 * fi) += g.segment<3>(3 * static_cast<int>(a));
     }
   }
-  if (air) addAirGradient(xk, h, s.gradV);
+  if (air) {
+    const auto begin = std::chrono::steady_clock::now();
+    addAirGradient(xk, h, s.gradV);
+    s.airMs += msSince(begin);
+  }
   s.grad = s.gradQ + s.gradV;
   if (!s.grad.allFinite()) {
     why = "non-finite forces";
@@ -192,7 +196,13 @@ bool ElasticSheet::Impl::assembleSystem(const NewtonState& s) {
       values[diagOffset[static_cast<std::size_t>(3 * fi + c)]] += mass[i] * s.massDiag;
   }
   const bool damped = params.stiffnessDamping > 0.0;
-  scatterBlocks(triHess, damped ? &triDamp : nullptr, s.dampScale, triOffset, values);
+  if (air) {
+    // Not timed as the air's: it adds 9 blocks per triangle to the
+    // membrane's own scatter (airMs has their computation, in the gradient).
+    scatterTrianglesWithAir(s.dampScale, values);
+  } else {
+    scatterBlocks(triHess, damped ? &triDamp : nullptr, s.dampScale, triOffset, values);
+  }
   scatterBlocks(hingeHess, damped ? &hingeDamp : nullptr, s.dampScale, hingeOffset, values);
   for (const auto& cp : contactPlanes) {
     const auto vi = static_cast<std::size_t>(cp.vertex);
@@ -230,7 +240,6 @@ bool ElasticSheet::Impl::assembleSystem(const NewtonState& s) {
           if (off[i] >= 0) values[off[i]] += grip.stiffness * grip.weights(a) * grip.weights(b);
         }
   }
-  if (air) addAirHessian(xk, s.h, values);
   return Eigen::Map<const VecX>(values, matrix.nonZeros()).allFinite();
 }
 
@@ -302,7 +311,13 @@ ElasticSheet::Impl::LineSearchResult ElasticSheet::Impl::lineSearch(NewtonState&
   }
   const double slopeQ = s.gradQ.dot(s.dx);
   const double contactNow = contactEnergy(s.xk, s.frictionEps) + gripEnergy(s.xk);
-  const double airNow = air ? airEnergy(s.xk, s.h) : 0.0;
+  const auto airTimed = [&](const std::vector<Vec3>& xs) {
+    const auto begin = std::chrono::steady_clock::now();
+    const double e = airEnergy(xs, s.h);
+    s.airMs += msSince(begin);
+    return e;
+  };
+  const double airNow = air ? airTimed(s.xk) : 0.0;
   step = 1.0;
   for (int ls = 0; ls <= kMaxLineSearchHalvings; ++ls, step *= 0.5) {
     applyStep(s, step);
@@ -312,7 +327,7 @@ ElasticSheet::Impl::LineSearchResult ElasticSheet::Impl::lineSearch(NewtonState&
     for (std::size_t k = 0; k < hinges.size(); ++k) deltaV += hingeTrial[k] - hingeEnergy[k];
     if (!contactPlanes.empty() || !faceContacts.empty() || !gripBuffer.empty())
       deltaV += contactEnergy(s.xTrial, s.frictionEps) + gripEnergy(s.xTrial) - contactNow;
-    if (air) deltaV += airEnergy(s.xTrial, s.h) - airNow;
+    if (air) deltaV += airTimed(s.xTrial) - airNow;
     const double deltaPhi = step * slopeQ + 0.5 * step * step * curvature + deltaV;
     if (std::isfinite(deltaPhi) && deltaPhi <= kArmijo * step * slope)
       return LineSearchResult::Accepted;
@@ -379,8 +394,7 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
   if (air) {
     const auto begin = std::chrono::steady_clock::now();
     air->beginStep(x, v, t0, t1, collidersOn() ? contact.colliders : nullptr);
-    stats.airMs +=
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin).count();
+    s.airMs += msSince(begin);
   }
   findContacts(x, s.xk, s.h, stats);
   const bool debugNewton = debugOptions().newton;
@@ -421,6 +435,7 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
     why = os.str();
     return false;
   }
+  stats.airMs += s.airMs;
   return finishSubstep(s, stats, why);
 }
 

@@ -217,8 +217,18 @@ struct ElasticSheet::Impl {
   // The air's part of the incremental potential at xs (J): its implicit
   // terms and the work of its explicit forces.
   double airEnergy(const std::vector<Vec3>& xs, double h) const;
-  void addAirGradient(const std::vector<Vec3>& xs, double h, VecX& out) const;
-  void addAirHessian(const std::vector<Vec3>& xs, double h, double* values) const;
+  // The gradient at xs, keeping every triangle's Hessian block there
+  // (airHess: the centroid's Hessian / 9) for the assembly that follows.
+  std::vector<Mat3> airHess;
+  // Wall-time milliseconds since `start` (the air's timing).
+  static double msSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+        .count();
+  }
+  void addAirGradient(const std::vector<Vec3>& xs, double h, VecX& out);
+  // The triangles' element blocks (membrane, its damping, the air's) into
+  // the matrix, one scatter per triangle.
+  void scatterTrianglesWithAir(double dampScale, double* values) const;
 
   // ---- step scratch ----
   std::vector<Pin> pinBuffer;
@@ -238,6 +248,9 @@ struct ElasticSheet::Impl {
   struct NewtonState {
     double t0 = 0.0;
     double h = 0.0;
+    // The air's terms (set-up, energy, gradient, Hessian), wall time; the
+    // Hessian's assembly adds to it through a const state.
+    mutable double airMs = 0.0;
     double massDiag = 0.0;     // lumped mass / damping diagonal: 1/h^2 + alpha/h
     double dampScale = 0.0;    // Rayleigh stiffness damping beta / h
     double frictionEps = 0.0;  // kFrictionSpeed h: static friction below it

@@ -135,6 +135,12 @@ struct ShotReport {
   // The contacts' share of the simulation step (elastic, geometric, cones,
   // rebuild, isometry and contact stages).
   double contactShareOfStep() const;
+  // The air (docs/AIR.md): whether it ran, and the time its terms took in
+  // the elastic step (set-up, energy, gradient, Hessian), and their share
+  // of the step.
+  bool airOn = false;
+  double airMs = 0.0;
+  double airShareOfStep() const;
   // Tearing: whether it ran, each tip advance (frame, tear, where
   // from, E_r and E_f) and the tears' paths in the pattern at the end.
   bool tearingOn = false;

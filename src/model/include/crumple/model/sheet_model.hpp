@@ -60,6 +60,7 @@ struct FrameStats {
   int selfContactDropped = 0;  // steps that went on without self-contact
   double contactMs = 0.0;      // collider work (timing only)
   double selfContactMs = 0.0;  // self-contact work (timing only)
+  double airMs = 0.0;          // the air's terms in the elastic step (timing only)
   long selfContactSteps = 0;
   std::vector<std::pair<const char*, double>> stageMs;  // the frame's stages, in order
   // The crumpling model's (paper::HybridStepStats); absent for the elastic model.

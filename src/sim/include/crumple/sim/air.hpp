@@ -69,6 +69,14 @@ struct AirTriangleFrame {
 // coordinates when asked.
 double airTriangleEnergy(const AirTriangleFrame& frame, double h, const Vec3& x0, const Vec3& x1,
                          const Vec3& x2, Vec9* gradient = nullptr, Mat9* hessian = nullptr);
+// That energy's Hessian with respect to the centroid (its Hessian with
+// respect to the nine coordinates is this block / 9 for every vertex pair).
+Mat3 airCentroidHessian(const AirTriangleFrame& frame, double h, const Vec3& x0, const Vec3& x1,
+                        const Vec3& x2);
+// That energy's Hessian with respect to the centroid (its Hessian with
+// respect to the nine coordinates is this block / 9 for every vertex pair).
+Mat3 airCentroidHessian(const AirTriangleFrame& frame, double h, const Vec3& x0, const Vec3& x1,
+                        const Vec3& x2);
 
 // The explicit forces on one triangle's vertices at positions x and
 // velocities v (N): the circulation's lift, translational and rotational
