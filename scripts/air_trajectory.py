@@ -2,8 +2,9 @@
 """The flight of a falling sheet drawn side on, as Andersen, Pesavento & Wang
 (2005) draw their plates' trajectories: from `crumple inspect --json`, the
 sheet's cross-section in the x-y plane (a segment through its centre of mass,
-perpendicular to its mean normal, as long as its chord) every few frames,
-the centre's path and the table (y = 0). Writes a PNG (stdlib only).
+perpendicular to its mean normal, as long as its chord) every few frames up
+to the frame it lands on, the centre's path and the table (y = 0). Writes a
+PNG (stdlib only).
 
 Usage: scripts/air_trajectory.py INSPECT.json OUT.png [--every N]
 """
@@ -52,6 +53,10 @@ def main():
     ap.add_argument("--every", type=int, default=0, help="frames between sections (default: ~60 drawn)")
     args = ap.parse_args()
     frames = json.load(open(args.inspect))["frames"]
+    # The flight: up to the first frame touching a collider (it rests after).
+    landed = next((k for k, f in enumerate(frames) if f.get("contacts", 0) > 0), None)
+    if landed is not None:
+        frames = frames[:landed + 1]
     ext = frames[0]["extent"]
     chord = max(math.hypot(ext[0], ext[1]), 1e-3)
     every = args.every or max(1, len(frames) // 60)
