@@ -18,29 +18,15 @@
 #include "crumple/core/error.hpp"
 #include "crumple/io/animation.hpp"
 #include "crumple/io/scene.hpp"
+#include "scene_test.hpp"
 
 namespace crumple::io {
 namespace {
 
-const std::string kData = CRUMPLE_IO_TEST_DATA;
+using testing::expectError;
+using testing::kData;
+using testing::parse;
 constexpr double kPi = 3.14159265358979323846;
-
-SceneSpec parse(const std::string& text) { return parseScene(text, "test.toml", kData); }
-
-// Parsing `text` must throw InputError whose message starts with
-// "test.toml:LINE: 'KEY': " and contains every fragment.
-void expectError(const std::string& text, long line, const std::string& key,
-                 std::initializer_list<std::string> fragments = {}) {
-  try {
-    parse(text);
-    ADD_FAILURE() << "expected InputError for:\n" << text;
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    const std::string prefix = "test.toml:" + std::to_string(line) + ": '" + key + "': ";
-    EXPECT_EQ(msg.rfind(prefix, 0), 0u) << "message: " << msg << "\nexpected prefix: " << prefix;
-    for (const std::string& f : fragments) EXPECT_NE(msg.find(f), std::string::npos) << msg;
-  }
-}
 
 const std::string kSheet = "[sheet]\nwidth = 21\nheight = 29.7\n";
 

@@ -10,7 +10,6 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
-#include <sstream>
 #include <vector>
 
 #include "crumple/cache/pcache.hpp"
@@ -250,16 +249,8 @@ TEST(AirSamples, ASheetOnADeskSlidesOnlyAboveTheWindWhereDragBeatsFriction) {
 
 TEST(AirSamples, AGustyShotIsByteIdenticalOnOneAndTwoThreads) {
   TempDir dir;
-  std::string caches[2];
-  for (const int threads : {1, 2}) {
-    std::ostringstream args;
-    const std::string out = (dir / std::to_string(threads)).string();
-    args << "simulate " << sourcePath("samples/desk-draught") << " --frames 0-30 --threads "
-         << threads << " --out " << out;
-    const auto r = runCrumple(args.str());
-    ASSERT_EQ(r.status, 0) << r.output;
-    caches[threads - 1] = readFile(out + "/cache.pcache");
-  }
+  const auto caches =
+      cachesOnOneAndTwoThreads(sourcePath("samples/desk-draught") + " --frames 0-30", dir);
   EXPECT_FALSE(caches[0].empty());
   EXPECT_TRUE(caches[0] == caches[1]) << "byte-identical on 1 and 2 threads";
 }

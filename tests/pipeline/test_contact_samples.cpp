@@ -122,16 +122,7 @@ TEST(ContactSamples, FoldOverLiesOnItselfWithoutPassingThrough) {
 // same cache on 1 and on 2 threads.
 TEST(ContactSamples, FoldOverIsByteIdenticalOnOneAndTwoThreads) {
   TempDir dir;
-  std::string caches[2];
-  for (const int threads : {1, 2}) {
-    std::ostringstream args;
-    const std::string out = (dir / std::to_string(threads)).string();
-    args << "simulate " << sourcePath("samples/fold-over") << " --threads " << threads << " --out "
-         << out;
-    const auto r = crumple::testing::runCrumple(args.str());
-    ASSERT_EQ(r.status, 0) << r.output;
-    caches[threads - 1] = crumple::testing::readFile(out + "/cache.pcache");
-  }
+  const auto caches = cachesOnOneAndTwoThreads(sourcePath("samples/fold-over"), dir);
   EXPECT_FALSE(caches[0].empty());
   EXPECT_TRUE(caches[0] == caches[1]) << "byte-identical on 1 and 2 threads";
 }

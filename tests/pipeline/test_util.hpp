@@ -227,3 +227,23 @@ inline std::string sci(double v) {
   return buf;
 }
 }  // namespace crumple::testing
+
+namespace crumple::testing {
+
+// `crumple simulate ARGS --threads N --out DIR/N` for N = 1 and 2 (ARGS:
+// the scene and any options); the two caches' bytes, each run's exit
+// status checked.
+inline std::array<std::string, 2> cachesOnOneAndTwoThreads(const std::string& args,
+                                                           const TempDir& dir) {
+  std::array<std::string, 2> caches;
+  for (const int threads : {1, 2}) {
+    const std::string out = (dir / std::to_string(threads)).string();
+    const auto r =
+        runCrumple("simulate " + args + " --threads " + std::to_string(threads) + " --out " + out);
+    EXPECT_EQ(r.status, 0) << r.output;
+    caches[static_cast<std::size_t>(threads - 1)] = readFile(out + "/cache.pcache");
+  }
+  return caches;
+}
+
+}  // namespace crumple::testing
