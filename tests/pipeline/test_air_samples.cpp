@@ -76,8 +76,13 @@ TEST(AirSamples, FallFlatReachesTheTerminalSpeedAndFallsThreeTimesSlower) {
   TempDir dir;
   const io::SceneSpec scene = io::loadScene(sourcePath("samples/fall-flat/scene.toml"));
   ASSERT_TRUE(scene.sim.air.has_value());
-  const Flight air = flightOf(simulateSample("fall-flat", dir));
+  const std::string cachePath = simulateSample("fall-flat", dir);
+  const Flight air = flightOf(cachePath);
   ASSERT_GE(air.landed, 0) << "the sheet lands within the shot";
+  // The summary says the air ran and what it cost.
+  const std::string summary = readFile(fs::path(cachePath).parent_path() / "summary.json");
+  EXPECT_NE(summary.find("\"air\":true"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"air\":{\"ms_per_frame\":"), std::string::npos) << summary;
   // Mean descent speed over the last 0.5 s of the fall (the frames before it lands).
   const std::size_t k1 = static_cast<std::size_t>(air.landed) - 1;
   std::size_t k0 = 0;
@@ -89,11 +94,14 @@ TEST(AirSamples, FallFlatReachesTheTerminalSpeedAndFallsThreeTimesSlower) {
       std::sqrt(2.0 * scene.paper.material.arealDensity() * 9.81 / (a.density * a.dragNormal));
   // The same sheet in a vacuum: no [air], and no mass damping either (the
   // stand-in for air drag a scene without [air] runs).
-  const Flight vacuum = flightOf(simulateSample("fall-flat", dir, -1, [](io::SceneSpec& s) {
+  const std::string vacuumPath = simulateSample("fall-flat", dir, -1, [](io::SceneSpec& s) {
     s.sim.air.reset();
     s.sim.massDamping = 0.0;
     s.name = "fall-flat-vacuum";
-  }));
+  });
+  const Flight vacuum = flightOf(vacuumPath);
+  EXPECT_NE(readFile(fs::path(vacuumPath).parent_path() / "summary.json").find("\"air\":false"),
+            std::string::npos);
   ASSERT_GE(vacuum.landed, 1);
   // Down to 5 mm above the table (the last frame is the one touching it).
   const double drop = air.centroid.front().y() - 0.005;

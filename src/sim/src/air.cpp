@@ -366,7 +366,5 @@ const std::vector<Vec3>& AirModel::explicitForces() const { return impl_->forces
 const std::vector<double>& AirModel::exposure() const { return impl_->exposure; }
 const std::vector<double>& AirModel::openness() const { return impl_->openness; }
 double AirModel::chord(std::size_t triangle) const { return impl_->chordOf(triangle); }
-double AirModel::stepLength() const { return impl_->h; }
-const AirParams& AirModel::params() const { return impl_->params; }
 
 }  // namespace crumple::sim

@@ -127,8 +127,6 @@ class AirModel {
   const std::vector<double>& exposure() const;
   const std::vector<double>& openness() const;
   double chord(std::size_t triangle) const;
-  double stepLength() const;
-  const AirParams& params() const;
 
  private:
   struct Impl;
