@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
     if (without.sim.air) {
       without.sim.air.reset();
     } else {
-      with.sim.air = sim::AirParams{};
+      with.sim.air.emplace();
     }
     std::vector<double> withMs, withoutMs, airMs, airShare;
     Row row;

@@ -38,9 +38,8 @@ def scene_text(preset, width_cm, angle_deg):
     text = text.replace("u_axis = [0.8660254, 0.5, 0.0]", f"u_axis = [{c:.8f}, {s:.8f}, 0.0]")
     text = text.replace("origin = [-2.165, 148.75, 10.0]",
                         f"origin = [{-width_cm / 2 * c:.4f}, {150 - width_cm / 2 * s:.4f}, 10.0]")
-    if width_cm > 10:  # wide sheets: fall-flutter's coarser mesh and 12 substeps
-        text = text.replace("max_edge = 1.0", "max_edge = 2.0").replace("substeps = 8",
-                                                                         "substeps = 12")
+    if width_cm > 10:  # wide sheets: fall-flutter's coarser mesh
+        text = text.replace("max_edge = 1.0", "max_edge = 2.0")
     return text
 
 

@@ -143,6 +143,19 @@ void pieceMotion(const std::vector<std::array<int, 3>>& triangles, const Pieces&
   }
 }
 
+// 1/2 rho A C_D(alpha) times the exposure (kg/m) of the triangle at corners
+// p moving at `relative` to the air (paper eq. (5.5)'s C_D(alpha)).
+double dragOf(const AirParams& params, const std::array<Vec3, 3>& p, const Vec3& relative,
+              double exposure) {
+  const Vec3 big = (p[1] - p[0]).cross(p[2] - p[0]);
+  const double twiceArea = big.norm();
+  if (!(twiceArea > 0.0)) return 0.0;
+  const double speed = relative.norm();
+  const double sin2 = speed > kStill ? std::pow(relative.dot(big) / (twiceArea * speed), 2.0) : 1.0;
+  const double cd = params.dragTangential + (params.dragNormal - params.dragTangential) * sin2;
+  return 0.25 * params.density * twiceArea * cd * exposure;
+}
+
 }  // namespace
 
 std::string airParamsProblem(const AirParams& p) {
@@ -245,7 +258,8 @@ struct AirModel::Impl {
   std::size_t vertexCount = 0;
   double h = 0.0;
   std::vector<AirTriangleFrame> frames;
-  std::vector<Vec3> forces;
+  std::vector<Vec3> forces, startForces, startLift;
+  std::vector<Vec3> windRate;  // per triangle, over the step
   std::vector<double> exposure, openness;
   ShelterCaster shelter;
 
@@ -259,7 +273,38 @@ struct AirModel::Impl {
   double chordOf(std::size_t t) const {
     return pieces.chord[static_cast<std::size_t>(pieces.of[t])];
   }
+  // The explicit forces at (x, v) with this step's wind, exposure and
+  // openness (per vertex, summed over its triangles in triangle order).
+  // liftOnly: the circulation's lift alone (openness 0 drops the added
+  // mass's forces).
+  void explicitAt(const std::vector<Vec3>& x, const std::vector<Vec3>& v, std::vector<Vec3>& out,
+                  bool liftOnly = false) const;
 };
+
+void AirModel::Impl::explicitAt(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
+                                std::vector<Vec3>& out, bool liftOnly) const {
+  out.assign(vertexCount, Vec3::Zero());
+  std::vector<Vec3> pieceVelocity, pieceSpin;
+  pieceMotion(triangles, pieces, x, v, pieceVelocity, pieceSpin);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const auto& tri = triangles[t];
+    AirExplicitInput in;
+    for (std::size_t a = 0; a < 3; ++a) {
+      in.x[a] = x[static_cast<std::size_t>(tri[a])];
+      in.v[a] = v[static_cast<std::size_t>(tri[a])];
+    }
+    const auto piece = static_cast<std::size_t>(pieces.of[t]);
+    in.wind = frames[t].wind;
+    in.windRate = windRate[t];
+    in.chord = chordOf(t);
+    in.pieceVelocity = pieceVelocity[piece];
+    in.pieceSpin = pieceSpin[piece];
+    in.exposure = exposure[t];
+    in.openness = liftOnly ? 0.0 : openness[t];
+    const auto fs = airExplicitForces(params, in);
+    for (std::size_t a = 0; a < 3; ++a) out[static_cast<std::size_t>(tri[a])] += fs[a];
+  }
+}
 
 AirModel::AirModel(const AirParams& params, const std::vector<std::array<int, 3>>& triangles,
                    const std::vector<Vec2>& pattern, std::size_t vertexCount)
@@ -275,7 +320,6 @@ void AirModel::beginStep(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
   m.h = t1 - t0;
   const std::size_t nt = m.triangles.size();
   m.frames.assign(nt, AirTriangleFrame{});
-  m.forces.assign(m.vertexCount, Vec3::Zero());
   m.exposure.assign(nt, 1.0);
   m.openness.assign(nt, 1.0);
   std::vector<Vec3> centroid(nt), relative(nt), windEnd(nt), windStart(nt);
@@ -301,8 +345,6 @@ void AirModel::beginStep(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
     }
     relative[t] = vbar - windEnd[t];
   }
-  std::vector<Vec3> pieceVelocity, pieceSpin;
-  pieceMotion(m.triangles, m.pieces, x, v, pieceVelocity, pieceSpin);
   // Only a folded sheet has parts that can stand in each other's air (the
   // self-contact gate, sim/self_contact.hpp): a flat or gently curved one
   // casts no rays.
@@ -328,37 +370,54 @@ void AirModel::beginStep(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
       }
     }
   }
+  m.windRate.resize(nt);
   for (std::size_t t = 0; t < nt; ++t) {
     const auto& tri = m.triangles[t];
-    AirExplicitInput in;
-    for (std::size_t a = 0; a < 3; ++a) {
-      in.x[a] = x[static_cast<std::size_t>(tri[a])];
-      in.v[a] = v[static_cast<std::size_t>(tri[a])];
-    }
-    const Vec3 big = (in.x[1] - in.x[0]).cross(in.x[2] - in.x[0]);
+    const std::array<Vec3, 3> corners{x[static_cast<std::size_t>(tri[0])],
+                                      x[static_cast<std::size_t>(tri[1])],
+                                      x[static_cast<std::size_t>(tri[2])]};
+    const Vec3 big = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
     const double twiceArea = big.norm();
     AirTriangleFrame& f = m.frames[t];
     f.centroidStart = centroid[t];
     f.inertiaTarget = centroid[t] + m.h * (relative[t] + windEnd[t]);
     f.wind = windEnd[t];
+    m.windRate[t] = (windEnd[t] - windStart[t]) / m.h;
     if (!(twiceArea > 0.0)) continue;
     f.normal = big / twiceArea;
-    const double area = 0.5 * twiceArea;
-    const double speed = relative[t].norm();
-    const double sin2 = speed > kStill ? std::pow(relative[t].dot(f.normal) / speed, 2.0) : 1.0;
-    const double cd = p.dragTangential + (p.dragNormal - p.dragTangential) * sin2;
-    f.drag = 0.5 * p.density * area * cd * m.exposure[t];
-    f.addedMass = p.density * p.addedMass * m.chordOf(t) * area * m.openness[t];
-    in.wind = windEnd[t];
-    in.windRate = (windEnd[t] - windStart[t]) / m.h;
-    in.chord = m.chordOf(t);
-    in.pieceVelocity = pieceVelocity[static_cast<std::size_t>(m.pieces.of[t])];
-    in.pieceSpin = pieceSpin[static_cast<std::size_t>(m.pieces.of[t])];
-    in.exposure = m.exposure[t];
-    in.openness = m.openness[t];
-    const auto fs = airExplicitForces(p, in);
-    for (std::size_t a = 0; a < 3; ++a) m.forces[static_cast<std::size_t>(tri[a])] += fs[a];
+    f.drag = dragOf(p, corners, relative[t], m.exposure[t]);
+    f.addedMass = p.density * p.addedMass * m.chordOf(t) * 0.5 * twiceArea * m.openness[t];
   }
+  m.explicitAt(x, v, m.startForces);
+  m.explicitAt(x, v, m.startLift, true);
+  m.forces = m.startForces;
+}
+
+std::vector<Vec3> AirModel::correctStep(const std::vector<Vec3>& x1, const std::vector<Vec3>& v1) {
+  Impl& m = *impl_;
+  std::vector<Vec3> change;
+  m.explicitAt(x1, v1, change, true);
+  for (std::size_t i = 0; i < m.vertexCount; ++i) {
+    change[i] = 0.5 * (change[i] - m.startLift[i]);
+    m.forces[i] = m.startForces[i] + change[i];
+  }
+  // The drag's angle of attack likewise: C_D the mean of the start's and
+  // the end's (a turning face's drag would lag its turning by half a step).
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    const auto& tri = m.triangles[t];
+    std::array<Vec3, 3> p, w;
+    for (std::size_t a = 0; a < 3; ++a) {
+      p[a] = x1[static_cast<std::size_t>(tri[a])];
+      w[a] = v1[static_cast<std::size_t>(tri[a])];
+    }
+    AirTriangleFrame& f = m.frames[t];
+    const Vec3 u = (w[0] + w[1] + w[2]) / 3.0 - f.wind;
+    const double drag = 0.5 * (f.drag + dragOf(m.params, p, u, m.exposure[t]));
+    const Vec3 dragChange = (f.drag - drag) * u.norm() * u / 3.0;
+    for (std::size_t a = 0; a < 3; ++a) change[static_cast<std::size_t>(tri[a])] += dragChange;
+    f.drag = drag;
+  }
+  return change;
 }
 
 const std::vector<AirTriangleFrame>& AirModel::frames() const { return impl_->frames; }

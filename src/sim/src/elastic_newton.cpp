@@ -379,24 +379,7 @@ bool ElasticSheet::Impl::finishSubstep(NewtonState& s, StepStats& stats, std::st
   return true;
 }
 
-bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, StepStats& stats,
-                                 std::string& why) {
-  // Animated colliders: where the step begins, then where it ends.
-  if (collidersOn() && contact.moveColliders) {
-    contact.moveColliders(t0);
-    contact.moveColliders(t1);
-  }
-  if (!collectPins(t1, pins, why) || !collectGrips(t1, why)) return false;
-  NewtonState s;
-  s.t0 = t0;
-  s.h = t1 - t0;
-  startNewton(s);
-  if (air) {
-    const auto begin = std::chrono::steady_clock::now();
-    air->beginStep(x, v, t0, t1, collidersOn() ? contact.colliders : nullptr);
-    s.airMs += msSince(begin);
-  }
-  findContacts(x, s.xk, s.h, stats);
+bool ElasticSheet::Impl::newtonLoop(NewtonState& s, StepStats& stats, std::string& why) {
   const bool debugNewton = debugOptions().newton;
   const double tol = params.newtonTolerance * typicalEdge;
   // Nothing to solve when every vertex is pinned: the step is the pins.
@@ -435,6 +418,58 @@ bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, 
     why = os.str();
     return false;
   }
+  return true;
+}
+
+bool ElasticSheet::Impl::correctAir(NewtonState& s, StepStats& stats, std::string& why) {
+  const auto begin = std::chrono::steady_clock::now();
+  const double airBefore = s.airMs;
+  std::vector<Vec3> v1(vertexCount);
+  for (std::size_t i = 0; i < vertexCount; ++i) v1[i] = (s.xk[i] - x[i]) / s.h;
+  const std::vector<Vec3> change = air->correctStep(s.xk, v1);
+  // The corrected forces' minimiser, one Newton step away with the last
+  // factorisation (the potential's gradient at s.xk is now -change).
+  VecX rhs = VecX::Zero(3 * freeCount);
+  for (std::size_t i = 0; i < vertexCount; ++i)
+    if (const int fi = freeIndex[i]; fi >= 0) rhs.segment<3>(3 * fi) = change[i];
+  s.dx = solver.solve(rhs);
+  ++stats.solves;
+  if (solver.info() != Eigen::Success || !s.dx.allFinite()) {
+    why = "the air's corrector: Cholesky solve failed";
+    return false;
+  }
+  applyStep(s, 1.0);
+  s.xk.swap(s.xTrial);
+  // That linearisation errs by about |dx|^2 / edge: below 1e-4 edges for a
+  // step under kCorrectorLinearStep edges, far below backward Euler's own
+  // error over the step (h^2 |a|); a longer step is polished by Newton.
+  const double moved = s.dx.lpNorm<Eigen::Infinity>();
+  const bool ok = moved <= kCorrectorLinearStep * typicalEdge || newtonLoop(s, stats, why);
+  s.airMs = airBefore + msSince(begin);
+  return ok;
+}
+
+bool ElasticSheet::Impl::substep(double t0, double t1, const PinFunction& pins, StepStats& stats,
+                                 std::string& why) {
+  // Animated colliders: where the step begins, then where it ends.
+  if (collidersOn() && contact.moveColliders) {
+    contact.moveColliders(t0);
+    contact.moveColliders(t1);
+  }
+  if (!collectPins(t1, pins, why) || !collectGrips(t1, why)) return false;
+  NewtonState s;
+  s.t0 = t0;
+  s.h = t1 - t0;
+  startNewton(s);
+  if (air) {
+    const auto begin = std::chrono::steady_clock::now();
+    air->beginStep(x, v, t0, t1, collidersOn() ? contact.colliders : nullptr);
+    s.airMs += msSince(begin);
+  }
+  findContacts(x, s.xk, s.h, stats);
+  if (!newtonLoop(s, stats, why)) return false;
+  // The corrected step's cost, all of it, is the air's.
+  if (air && freeCount > 0 && !correctAir(s, stats, why)) return false;
   stats.airMs += s.airMs;
   return finishSubstep(s, stats, why);
 }

@@ -124,6 +124,9 @@ inline void pinBlasToOneThread() {
 constexpr std::size_t kMinChunk = 64;       // elements per parallelFor task
 constexpr double kArmijo = 1e-4;            // sufficient-decrease constant
 constexpr int kMaxLineSearchHalvings = 30;  // alpha down to ~1e-9
+// The air's corrector (correctAir): its one linear step is kept when no
+// vertex moves more than this many typical edges, else Newton polishes it.
+constexpr double kCorrectorLinearStep = 0.01;
 
 inline bool finite(const std::vector<Vec3>& xs) {
   for (const Vec3& p : xs)
@@ -288,6 +291,14 @@ struct ElasticSheet::Impl {
                               std::string& why);
   void traceNewtonIteration(const NewtonState& s, int it, double stepNorm, double step,
                             bool projected) const;
+  // Newton iterations from s.xk until the step falls below the tolerance;
+  // false with `why` when they do not within maxNewtonIterations.
+  bool newtonLoop(NewtonState& s, StepStats& stats, std::string& why);
+  // The air's explicit forces and drag corrected at the solved step s.xk
+  // (Heun's trapezoid, AirModel::correctStep), and the step moved to the
+  // corrected minimiser: one solve with the last factorisation, then Newton
+  // if that step is too long for its linearisation. False with `why`.
+  bool correctAir(NewtonState& s, StepStats& stats, std::string& why);
   // Contacts' failsafe, velocities and the new state from the converged s.xk.
   bool finishSubstep(NewtonState& s, StepStats& stats, std::string& why);
   bool stepRecursive(double t0, double t1, const PinFunction& pins, int depth, StepStats& stats,

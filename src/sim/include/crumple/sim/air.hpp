@@ -73,10 +73,6 @@ double airTriangleEnergy(const AirTriangleFrame& frame, double h, const Vec3& x0
 // respect to the nine coordinates is this block / 9 for every vertex pair).
 Mat3 airCentroidHessian(const AirTriangleFrame& frame, double h, const Vec3& x0, const Vec3& x1,
                         const Vec3& x2);
-// That energy's Hessian with respect to the centroid (its Hessian with
-// respect to the nine coordinates is this block / 9 for every vertex pair).
-Mat3 airCentroidHessian(const AirTriangleFrame& frame, double h, const Vec3& x0, const Vec3& x1,
-                        const Vec3& x2);
 
 // The explicit forces on one triangle's vertices at positions x and
 // velocities v (N): the circulation's lift, translational and rotational
@@ -116,8 +112,17 @@ class AirModel {
   // the surface: air does not blow through a table (docs/AIR.md "Walls").
   void beginStep(const std::vector<Vec3>& x, const std::vector<Vec3>& v, double t0, double t1,
                  const ColliderSet* colliders = nullptr);
+  // The corrector (Heun's trapezoid, docs/AIR.md "Time step"): with the
+  // step solved to (x1, v1), the circulation's lift becomes the mean of its
+  // values at the step's start and at (x1, v1), and so does each frame's
+  // drag coefficient (its angle of attack); the caller moves the step to
+  // the corrected minimiser. The added mass's forces, exposure and
+  // openness stay the start's. Returns how much the forces on each vertex
+  // changed at (x1, v1) (N).
+  std::vector<Vec3> correctStep(const std::vector<Vec3>& x1, const std::vector<Vec3>& v1);
   const std::vector<AirTriangleFrame>& frames() const;
-  // Per vertex (N), summed over its triangles in triangle order.
+  // Per vertex (N), summed over its triangles in triangle order: at the
+  // step's start, with the lift corrected after correctStep.
   const std::vector<Vec3>& explicitForces() const;
   // Per triangle, in [0, 1] (docs/AIR.md "Sheltering"): how much of the
   // flow reaches it (its upwind ray's free length over the chord), which
