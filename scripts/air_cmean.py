@@ -2,16 +2,16 @@
 """c_mean of the crumpling samples with and without [air] (docs/AIR.md "c_mean").
 
 Simulates each sample (no rendering) for seeds 1..N without [air], with
-[air] (still air, the defaults: no Rayleigh mass damping) and, with
---kept-damping, with [air] and the default mass damping kept
-([sim] mass_damping = 0.5), reads c_mean_mean (docs/BENCH.md: the mean over
+[air] (still air, the defaults; [sim] mass_damping keeps its 0.5/s) and,
+with --no-damping, with [air] and no Rayleigh mass damping
+([sim] mass_damping = 0: the air the only drag), reads c_mean_mean (docs/BENCH.md: the mean over
 the frames of the mean |l - L| / L over the edges) from each run's summary
 and prints a Markdown table: medians, ranges, the probability that a run
 with air has the larger c_mean (Mann-Whitney U / (n m)) and its two-sided p
 (normal approximation, ties averaged).
 
 Usage: scripts/air_cmean.py [--crumple build/crumple] [--seeds 20] [--jobs 2]
-       [--samples crumple,cylinder-fold,...] [--kept-damping]
+       [--samples crumple,cylinder-fold,...] [--no-damping]
 """
 import argparse
 import json
@@ -26,7 +26,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SAMPLES = "crumple,cylinder-fold,first-singularity,moebius,unload,slide-on-table,wiggle"
-EXTRA = {"without": "", "air": "\n[air]\n", "air, damping kept": "\n[air]\n\n[sim]\nmass_damping = 0.5\n"}
+EXTRA = {"without": "", "air": "\n[air]\n", "air, no damping": "\n[air]\n\n[sim]\nmass_damping = 0.0\n"}
 
 
 def find(obj, key):
@@ -77,9 +77,9 @@ def main():
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--samples", default=SAMPLES)
-    ap.add_argument("--kept-damping", action="store_true")
+    ap.add_argument("--no-damping", action="store_true")
     args = ap.parse_args()
-    conditions = ["without", "air"] + (["air, damping kept"] if args.kept_damping else [])
+    conditions = ["without", "air"] + (["air, no damping"] if args.no_damping else [])
     runs = [(s, seed, c) for s in args.samples.split(",") for seed in range(1, args.seeds + 1)
             for c in conditions]
     with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(args.jobs) as pool:

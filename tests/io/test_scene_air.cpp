@@ -28,13 +28,13 @@ TEST(SceneAir, AbsentMeansNoAirAndTheMassDampingStays) {
   EXPECT_FALSE(parse(kSheet + "[air]\nenabled = false\n").sim.air.has_value());
 }
 
-TEST(SceneAir, TheTableAloneGivesStillAirWithTheDefaultsAndNoMassDamping) {
+TEST(SceneAir, TheTableAloneGivesStillAirWithTheDefaults) {
   const SceneSpec s = parse(kSheet + "[air]\n");
   ASSERT_TRUE(s.sim.air.has_value());
   EXPECT_EQ(*s.sim.air, sim::AirParams{});
-  EXPECT_EQ(s.sim.massDamping, 0.0);
-  // A scene that asks for mass damping keeps it, whatever the order.
-  EXPECT_EQ(parse(kSheet + "[air]\n[sim]\nmass_damping = 0.25\n").sim.massDamping, 0.25);
+  // The mass damping is [sim]'s own, with or without air.
+  EXPECT_EQ(s.sim.massDamping, sim::SimParams{}.massDamping);
+  EXPECT_EQ(parse(kSheet + "[air]\n[sim]\nmass_damping = 0\n").sim.massDamping, 0.0);
 }
 
 TEST(SceneAir, EveryKeyReachesAirParams) {

@@ -82,10 +82,6 @@ void SceneParser::parseAir(const toml::table* table) {
     air.addedMass = inRange("added_mass", *v, 0.0, kMaxCoefficient);
   if (auto b = r.boolean("shelter")) air.shelter = *b;
   spec_.sim.air = air;
-  // The air is the drag that [sim] mass_damping stood in for: off unless the
-  // scene asks for it.
-  const toml::table* sim = root_["sim"].as_table();
-  if (!sim || !sim->contains("mass_damping")) spec_.sim.massDamping = 0.0;
 }
 
 }  // namespace crumple::io::detail
