@@ -107,33 +107,33 @@ def main():
         frames = list(pool.map(lambda r: run(args.crumple, tmp, *r), runs))
     rows = {r: (flutter_row if r[0] == "fall-flutter" else strip_row)(f)
             for r, f in zip(runs, frames)}
-    fall = lambda r: f"{r['fall']:.2f}" + ("" if r["landed"] else "+")  # noqa: E731
     print("fall-flutter (48 fps):\n")
-    print("| substeps | release (deg) | first swing (deg) | largest tilt (deg) | reversals "
-          "| fall (s) |")
-    print("| --- | --- | --- | --- | --- | --- |")
-    for s in subs:
-        mine = [(r, v) for r, v in rows.items() if r[0] == "fall-flutter" and r[1] == s]
-        for (_, _, a), v in mine:
-            print(f"| {s} | {a:g} | {v['first']:.1f} | {v['tilt']:.1f} | {v['reversals']} "
-                  f"| {fall(v)} |")
-        med = lambda k: statistics.median(v[k] for _, v in mine)  # noqa: E731
-        print(f"| {s} | median | {med('first'):.1f} | {med('tilt'):.1f} | "
-              f"{med('reversals'):g} | {med('fall'):.2f} |")
+    print_table(rows, "fall-flutter", subs, [("first swing (deg)", "first", ".1f"),
+                                             ("largest tilt (deg)", "tilt", ".1f"),
+                                             ("reversals", "reversals", "g")])
     print("\nfall-strip (48 fps; its steady tumble between 2 and 4 s; + still falling at "
           "the shot's end):\n")
-    print("| substeps | release (deg) | descent (m/s) | sideways (m/s) | turns per s "
-          "| turns one way | fall (s) |")
-    print("| --- | --- | --- | --- | --- | --- | --- |")
-    for s in subs:
-        mine = [(r, v) for r, v in rows.items() if r[0] == "fall-strip" and r[1] == s]
-        for (_, _, a), v in mine:
-            print(f"| {s} | {a:g} | {v['descent']:.3f} | {v['sideways']:.3f} | {v['rate']:.2f} "
-                  f"| {v['turns']:.1f} | {fall(v)} |")
-        med = lambda k: statistics.median(v[k] for _, v in mine)  # noqa: E731
-        print(f"| {s} | median | {med('descent'):.3f} | {med('sideways'):.3f} | "
-              f"{med('rate'):.2f} | {med('turns'):.1f} | {med('fall'):.2f} |")
+    print_table(rows, "fall-strip", subs, [("descent (m/s)", "descent", ".3f"),
+                                           ("sideways (m/s)", "sideways", ".3f"),
+                                           ("turns per s", "rate", ".2f"),
+                                           ("turns one way", "turns", ".1f")])
 
+
+def print_table(rows, sample, subs, columns):
+    """One row per (substeps, angle) and each substep count's medians."""
+    heads = " | ".join(h for h, _, _ in columns)
+    print(f"| substeps | release (deg) | {heads} | fall (s) |")
+    print("| --- | --- | " + "--- | " * len(columns) + "--- |")
+    for s in subs:
+        mine = [(r, v) for r, v in rows.items() if r[0] == sample and r[1] == s]
+        for (_, _, a), v in mine:
+            cells = " | ".join(format(v[k], f) for _, k, f in columns)
+            fall = f"{v['fall']:.2f}" + ("" if v["landed"] else "+")
+            print(f"| {s} | {a:g} | {cells} | {fall} |")
+        cells = " | ".join(format(statistics.median(v[k] for _, v in mine), f)
+                           for _, k, f in columns)
+        print(f"| {s} | median | {cells} | "
+              f"{statistics.median(v['fall'] for _, v in mine):.2f} |")
 
 if __name__ == "__main__":
     sys.exit(main())
