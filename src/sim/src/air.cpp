@@ -274,16 +274,17 @@ struct AirModel::Impl {
     return pieces.chord[static_cast<std::size_t>(pieces.of[t])];
   }
   // The explicit forces at (x, v) with this step's wind, exposure and
-  // openness (per vertex, summed over its triangles in triangle order).
-  // liftOnly: the circulation's lift alone (openness 0 drops the added
-  // mass's forces).
-  void explicitAt(const std::vector<Vec3>& x, const std::vector<Vec3>& v, std::vector<Vec3>& out,
-                  bool liftOnly = false) const;
+  // openness into `all`, and the circulation's lift alone (openness 0 drops
+  // the added mass's forces) into `lift`, each when given (per vertex,
+  // summed over its triangles in triangle order).
+  void explicitAt(const std::vector<Vec3>& x, const std::vector<Vec3>& v, std::vector<Vec3>* all,
+                  std::vector<Vec3>* lift) const;
 };
 
 void AirModel::Impl::explicitAt(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
-                                std::vector<Vec3>& out, bool liftOnly) const {
-  out.assign(vertexCount, Vec3::Zero());
+                                std::vector<Vec3>* all, std::vector<Vec3>* lift) const {
+  for (std::vector<Vec3>* out : {all, lift})
+    if (out) out->assign(vertexCount, Vec3::Zero());
   std::vector<Vec3> pieceVelocity, pieceSpin;
   pieceMotion(triangles, pieces, x, v, pieceVelocity, pieceSpin);
   for (std::size_t t = 0; t < triangles.size(); ++t) {
@@ -300,9 +301,12 @@ void AirModel::Impl::explicitAt(const std::vector<Vec3>& x, const std::vector<Ve
     in.pieceVelocity = pieceVelocity[piece];
     in.pieceSpin = pieceSpin[piece];
     in.exposure = exposure[t];
-    in.openness = liftOnly ? 0.0 : openness[t];
-    const auto fs = airExplicitForces(params, in);
-    for (std::size_t a = 0; a < 3; ++a) out[static_cast<std::size_t>(tri[a])] += fs[a];
+    for (std::vector<Vec3>* out : {all, lift}) {
+      if (!out) continue;
+      in.openness = out == lift ? 0.0 : openness[t];
+      const auto fs = airExplicitForces(params, in);
+      for (std::size_t a = 0; a < 3; ++a) (*out)[static_cast<std::size_t>(tri[a])] += fs[a];
+    }
   }
 }
 
@@ -388,15 +392,14 @@ void AirModel::beginStep(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
     f.drag = dragOf(p, corners, relative[t], m.exposure[t]);
     f.addedMass = p.density * p.addedMass * m.chordOf(t) * 0.5 * twiceArea * m.openness[t];
   }
-  m.explicitAt(x, v, m.startForces);
-  m.explicitAt(x, v, m.startLift, true);
+  m.explicitAt(x, v, &m.startForces, &m.startLift);
   m.forces = m.startForces;
 }
 
 std::vector<Vec3> AirModel::correctStep(const std::vector<Vec3>& x1, const std::vector<Vec3>& v1) {
   Impl& m = *impl_;
   std::vector<Vec3> change;
-  m.explicitAt(x1, v1, change, true);
+  m.explicitAt(x1, v1, nullptr, &change);
   for (std::size_t i = 0; i < m.vertexCount; ++i) {
     change[i] = 0.5 * (change[i] - m.startLift[i]);
     m.forces[i] = m.startForces[i] + change[i];
