@@ -384,7 +384,17 @@ void HybridSheet::Impl::elasticStep(double t, double dt, const sim::PinFunction&
     stats.elastic = m.elastic->advance(t, dt, pins);
     ++stats.elasticRetries;
   }
-  if (!(m.keepElasticStepOutOfItself(elasticStart, dt) > 0.0)) ++stats.elasticHeldStill;
+  if (!elasticStart.empty()) {
+    // Held: a handle pins S_P, or a finger grips it, somewhere in the step.
+    std::vector<sim::Pin> held;
+    std::vector<sim::Grip> gripped;
+    pins(t + dt, held);
+    if (m.grips) m.grips(t + dt, gripped);
+    const bool isHeld = !held.empty() || !gripped.empty();
+    if (!(m.keepElasticStepOutOfItself(elasticStart, dt, isHeld) > 0.0) &&
+        m.elastic->positions() == elasticStart)
+      ++stats.elasticHeldStill;
+  }
 }
 
 // paper Fig. 16 (d)-(e), thesis Algorithm 1: the geometric step of S_G (junctions, edge flips,

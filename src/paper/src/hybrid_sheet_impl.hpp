@@ -142,17 +142,20 @@ struct HybridSheet::Impl {
   bool undoStretchingGeometry(const mesh::SheetMesh& spBefore, const GeometricMesh& sgBefore,
                               const std::vector<Vec3>& elasticX, const std::vector<Vec3>& elasticV,
                               std::vector<Vec3>& positions, HybridStepStats& stats);
-  // The largest fraction of the move from x0 to x1 (S_P's vertices) that
-  // passes no more edges through another layer than x0 had; x1 becomes that
-  // point of the move (crossingGuard() > 0). Returns the fraction.
-  double keepMoveOutOfItself(const std::vector<Vec3>& x0, std::vector<Vec3>& x1) const;
+  // The largest fraction of the move from `base` (x0 when null, or a rigid
+  // motion of x0) to x1 (S_P's vertices) that passes no more edges through
+  // another layer than x0 had; x1 becomes that point of the move
+  // (crossingGuard() > 0). Returns the fraction.
+  double keepMoveOutOfItself(const std::vector<Vec3>& x0, std::vector<Vec3>& x1,
+                             const std::vector<Vec3>* base = nullptr) const;
   // Whether x1 passes more edges through another layer than x0 does (S_P's
   // vertices; false when crossingGuard() is 0).
   bool passesThroughItself(const std::vector<Vec3>& x0, const std::vector<Vec3>& x1) const;
   // The elastic step from x0 over dt, shortened to the largest fraction that
   // passes no more of S_P's edges through another layer than x0 had
-  // (crossingGuard() > 0). Returns the fraction (1: the whole step).
-  double keepElasticStepOutOfItself(const std::vector<Vec3>& x0, double dt);
+  // (crossingGuard() > 0); a sheet not `held` by a handle or grip keeps the
+  // rigid part of its move. Returns the fraction (1: the whole step).
+  double keepElasticStepOutOfItself(const std::vector<Vec3>& x0, double dt, bool held);
   // The pins of an animation step from t to t + dt, with every handle that
   // lags behind its node (further from it than the node moves over the step)
   // brought on at most params.lagCatchUpSpeed faster than its node, its
