@@ -112,6 +112,32 @@ TEST(AirExplicit, TheMunkMomentIsTheDerivativeOfTheAirsKineticEnergy) {
   }
 }
 
+// The circulation's lift given beside the forces is the forces without the
+// added mass (openness 0), bit for bit: the corrector takes the lift so.
+TEST(AirExplicit, TheCirculationAloneIsTheForcesWithoutTheAddedMass) {
+  AirParams p;
+  Random r(12);
+  for (int trial = 0; trial < 10; ++trial) {
+    AirExplicitInput in;
+    in.x = {r.vec3(0.05), r.vec3(0.05), r.vec3(0.05)};
+    in.v = {r.vec3(1.0), r.vec3(1.0), r.vec3(1.0)};
+    in.wind = r.vec3(1.0);
+    in.windRate = r.vec3(1.0);
+    in.pieceVelocity = r.vec3(1.0);
+    in.pieceSpin = r.vec3(5.0);
+    in.chord = 0.1;
+    in.openness = 0.7;
+    std::array<Vec3, 3> circulation;
+    const auto all = airExplicitForces(p, in, &circulation);
+    in.openness = 0.0;
+    const auto lift = airExplicitForces(p, in);
+    for (std::size_t a = 0; a < 3; ++a) {
+      EXPECT_EQ(circulation[a], lift[a]) << trial;
+      EXPECT_GT((all[a] - lift[a]).norm(), 0.0) << trial;  // the added mass's part
+    }
+  }
+}
+
 TEST(AirExplicit, TranslationalLiftIsPerpendicularToTheRelativeVelocity) {
   AirParams p;
   p.rotationalLift = 0.0;
@@ -189,6 +215,34 @@ TEST(WindField, KeysInterpolateAndGustsHaveTheirSpeed) {
   EXPECT_EQ(WindField(p).at(Vec3(0.3, 0.1, 0.2), 1.7), gusty.at(Vec3(0.3, 0.1, 0.2), 1.7));
   p.gusts.seed = 6;
   EXPECT_NE(WindField(p).at(Vec3(0.3, 0.1, 0.2), 1.7), gusty.at(Vec3(0.3, 0.1, 0.2), 1.7));
+}
+
+// A step's wind, sampled at once for all points (WindField::sampleStep),
+// is the field's at both ends of the step, across a key and with gusts.
+TEST(WindField, AStepsSamplesAreTheFieldAtItsStartAndEnd) {
+  AirParams p;
+  p.wind = {{0.25, Vec3(0, 0, 0)}, {0.75, Vec3(3, 0.2, 0)}};
+  p.gusts.speed = 0.6;
+  p.gusts.seed = 2;
+  Random r(9);
+  std::vector<Vec3> points(40);
+  for (Vec3& x : points) x = r.vec3(2.0);
+  for (const bool gusts : {false, true}) {
+    if (!gusts) p.gusts.speed = 0.0;
+    if (gusts) p.gusts.speed = 0.6;
+    const WindField field(p);
+    for (const double t0 : {0.1, 0.7, 3.0}) {
+      const double t1 = t0 + 0.01;
+      std::vector<Vec3> start, end;
+      field.sampleStep(points, t0, t1, start, end);
+      ASSERT_EQ(start.size(), points.size());
+      ASSERT_EQ(end.size(), points.size());
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        EXPECT_LT((start[i] - field.at(points[i], t0)).norm(), 1e-12) << t0;
+        EXPECT_LT((end[i] - field.at(points[i], t1)).norm(), 1e-12) << t0;
+      }
+    }
+  }
 }
 
 TEST(AirModel, ChordsAreTwiceAreaOverPerimeterPerPiece) {

@@ -204,8 +204,10 @@ Mat3 airCentroidHessian(const AirTriangleFrame& f, double h, const Vec3& x0, con
   return hc;
 }
 
-std::array<Vec3, 3> airExplicitForces(const AirParams& p, const AirExplicitInput& in) {
+std::array<Vec3, 3> airExplicitForces(const AirParams& p, const AirExplicitInput& in,
+                                      std::array<Vec3, 3>* circulation) {
   std::array<Vec3, 3> out{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+  if (circulation) *circulation = out;
   const Vec3 e1 = in.x[1] - in.x[0], e2 = in.x[2] - in.x[0];
   const Vec3 big = e1.cross(e2);
   const double twiceArea = big.norm();
@@ -235,6 +237,7 @@ std::array<Vec3, 3> airExplicitForces(const AirParams& p, const AirExplicitInput
   // term).
   const Vec3 turning = in.pieceSpin - in.pieceSpin.dot(n) * n;
   total += (0.5 * rho * p.rotationalLift * in.chord * area) * turning.cross(uc);
+  if (circulation) circulation->fill(total / 3.0);
   // Added mass m: the air's momentum m (u.n) n changes with the normal, and
   // a changing wind carries m along (d/dt of dT/dv, T = 1/2 m (u.n)^2).
   const double m = p.density * in.openness * p.addedMass * in.chord * area;
@@ -301,11 +304,14 @@ void AirModel::Impl::explicitAt(const std::vector<Vec3>& x, const std::vector<Ve
     in.pieceVelocity = pieceVelocity[piece];
     in.pieceSpin = pieceSpin[piece];
     in.exposure = exposure[t];
-    for (std::vector<Vec3>* out : {all, lift}) {
-      if (!out) continue;
-      in.openness = out == lift ? 0.0 : openness[t];
-      const auto fs = airExplicitForces(params, in);
-      for (std::size_t a = 0; a < 3; ++a) (*out)[static_cast<std::size_t>(tri[a])] += fs[a];
+    // One evaluation gives both: the lift is its circulation's part.
+    in.openness = all ? openness[t] : 0.0;
+    std::array<Vec3, 3> circulation;
+    const auto fs = airExplicitForces(params, in, lift ? &circulation : nullptr);
+    for (std::size_t a = 0; a < 3; ++a) {
+      const auto i = static_cast<std::size_t>(tri[a]);
+      if (all) (*all)[i] += fs[a];
+      if (lift) (*lift)[i] += circulation[a];
     }
   }
 }
@@ -326,18 +332,20 @@ void AirModel::beginStep(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
   m.frames.assign(nt, AirTriangleFrame{});
   m.exposure.assign(nt, 1.0);
   m.openness.assign(nt, 1.0);
-  std::vector<Vec3> centroid(nt), relative(nt), windEnd(nt), windStart(nt);
+  std::vector<Vec3> centroid(nt), relative(nt), windEnd, windStart;
   for (std::size_t t = 0; t < nt; ++t) {
     const auto& tri = m.triangles[t];
-    const Vec3 c = (x[static_cast<std::size_t>(tri[0])] + x[static_cast<std::size_t>(tri[1])] +
-                    x[static_cast<std::size_t>(tri[2])]) /
-                   3.0;
+    centroid[t] = (x[static_cast<std::size_t>(tri[0])] + x[static_cast<std::size_t>(tri[1])] +
+                   x[static_cast<std::size_t>(tri[2])]) /
+                  3.0;
+  }
+  m.wind.sampleStep(centroid, t0, t1, windStart, windEnd);
+  for (std::size_t t = 0; t < nt; ++t) {
+    const auto& tri = m.triangles[t];
+    const Vec3& c = centroid[t];
     const Vec3 vbar = (v[static_cast<std::size_t>(tri[0])] + v[static_cast<std::size_t>(tri[1])] +
                        v[static_cast<std::size_t>(tri[2])]) /
                       3.0;
-    centroid[t] = c;
-    windEnd[t] = m.wind.at(c, t1);
-    windStart[t] = m.wind.at(c, t0);
     if (colliders != nullptr && colliders->size() > 0) {
       // No flow through a wall: the wind's normal part fades to nothing at it.
       const double reach = m.chordOf(t);

@@ -105,12 +105,18 @@ double ShelterCaster::hitDistance(std::size_t self, const Vec3& origin, const Ve
   double best = maxDistance;
   // A median-split tree over n triangles is about log2(n / kLeafSize) deep:
   // 64 entries hold any mesh that fits in memory.
-  std::array<int, 64> stack{};
+  struct Entry {
+    int node = 0;
+    double enter = 0.0;  // the ray's entry distance into the node's box
+  };
+  std::array<Entry, 64> stack{};
   int top = 0;
-  stack[top++] = 0;
+  if (const double enter = enterBox(nodes_.front().box, origin, inv, best); enter < best)
+    stack[static_cast<std::size_t>(top++)] = {0, enter};
   while (top > 0) {
-    const Node& node = nodes_[static_cast<std::size_t>(stack[static_cast<std::size_t>(--top)])];
-    if (!(enterBox(node.box, origin, inv, best) < best)) continue;
+    const Entry entry = stack[static_cast<std::size_t>(--top)];
+    if (!(entry.enter < best)) continue;  // a nearer hit was found since it was pushed
+    const Node& node = nodes_[static_cast<std::size_t>(entry.node)];
     if (node.left < 0) {
       for (int i = node.first; i < node.first + node.count; ++i) {
         const auto t = static_cast<std::size_t>(order_[static_cast<std::size_t>(i)]);
@@ -125,8 +131,16 @@ double ShelterCaster::hitDistance(std::size_t self, const Vec3& origin, const Ve
     }
     if (top + 2 > static_cast<int>(stack.size()))
       throw std::length_error("ShelterCaster: too deep");
-    stack[static_cast<std::size_t>(top++)] = node.left;
-    stack[static_cast<std::size_t>(top++)] = node.right;
+    // The nearer child is searched first (pushed last), so a hit in it
+    // prunes the farther one; the nearest hit is the same in any order.
+    const std::array<Entry, 2> children{
+        Entry{node.left,
+              enterBox(nodes_[static_cast<std::size_t>(node.left)].box, origin, inv, best)},
+        Entry{node.right,
+              enterBox(nodes_[static_cast<std::size_t>(node.right)].box, origin, inv, best)}};
+    const std::size_t nearer = children[1].enter < children[0].enter ? 1 : 0;
+    for (const std::size_t c : {1 - nearer, nearer})
+      if (children[c].enter < best) stack[static_cast<std::size_t>(top++)] = children[c];
   }
   return best;
 }

@@ -97,4 +97,35 @@ Vec3 WindField::at(const Vec3& x, double t) const {
   return w + gust;
 }
 
+void WindField::sampleStep(const std::vector<Vec3>& points, double t0, double t1,
+                           std::vector<Vec3>& atStart, std::vector<Vec3>& atEnd) const {
+  const Vec3 w0 = mean(t0), w1 = mean(t1);
+  atStart.assign(points.size(), w0);
+  atEnd.assign(points.size(), w1);
+  if (modes_.empty()) return;
+  const Vec3 travel1 = travel(t1);
+  const Vec3 shift = travel1 - travel(t0);
+  // phase(t0) = phase(t1) + delta, delta = k . (travel(t1) - travel(t0)) - omega (t1 - t0).
+  std::vector<double> cosDelta(modes_.size()), sinDelta(modes_.size());
+  for (std::size_t j = 0; j < modes_.size(); ++j) {
+    const Mode& m = modes_[j];
+    const double delta = m.wavevector.dot(shift) - m.frequency * (t1 - t0);
+    cosDelta[j] = std::cos(delta);
+    sinDelta[j] = std::sin(delta);
+  }
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec3 carried = points[i] - travel1;
+    Vec3 g0 = Vec3::Zero(), g1 = Vec3::Zero();
+    for (std::size_t j = 0; j < modes_.size(); ++j) {
+      const Mode& m = modes_[j];
+      const double phase = m.wavevector.dot(carried) + m.frequency * t1 + m.phase;
+      const double c = std::cos(phase), s = std::sin(phase);
+      g1 += c * m.amplitude;
+      g0 += (c * cosDelta[j] - s * sinDelta[j]) * m.amplitude;
+    }
+    atStart[i] += g0;
+    atEnd[i] += g1;
+  }
+}
+
 }  // namespace crumple::sim

@@ -37,6 +37,12 @@ class WindField {
   explicit WindField(const AirParams& params);
   Vec3 mean(double t) const;
   Vec3 at(const Vec3& x, double t) const;
+  // The wind at every point at t0 and at t1 (a step's start and end), as
+  // at() gives them to rounding: the mean wind and its travel once, and one
+  // sine and cosine per mode and point (a mode's phase at t0 is its phase at
+  // t1 shifted by the same angle everywhere).
+  void sampleStep(const std::vector<Vec3>& points, double t0, double t1, std::vector<Vec3>& atStart,
+                  std::vector<Vec3>& atEnd) const;
   // How far the mean wind has carried the air from time 0 to t (m).
   Vec3 travel(double t) const;
 
@@ -93,7 +99,10 @@ struct AirExplicitInput {
   double exposure = 1.0;              // in [0, 1]
   double openness = 1.0;              // in [0, 1]
 };
-std::array<Vec3, 3> airExplicitForces(const AirParams& params, const AirExplicitInput& in);
+// `circulation`, when given, receives the circulation's lift alone (the
+// forces with openness 0).
+std::array<Vec3, 3> airExplicitForces(const AirParams& params, const AirExplicitInput& in,
+                                      std::array<Vec3, 3>* circulation = nullptr);
 
 // The air of one sheet for ElasticSheet: built on its triangles and pattern
 // (the chord of every connected piece: twice its area over its perimeter,
