@@ -142,12 +142,12 @@ struct HybridSheet::Impl {
   bool undoStretchingGeometry(const mesh::SheetMesh& spBefore, const GeometricMesh& sgBefore,
                               const std::vector<Vec3>& elasticX, const std::vector<Vec3>& elasticV,
                               std::vector<Vec3>& positions, HybridStepStats& stats);
-  // The largest fraction of the move from `base` (x0 when null, or a rigid
-  // motion of x0) to x1 (S_P's vertices) that passes no more edges through
-  // another layer than x0 had; x1 becomes that point of the move
-  // (crossingGuard() > 0). Returns the fraction.
+  // The largest fraction of the move from x0 (or, fromRigidMotion, from the
+  // rigid motion that best takes x0 to x1) to x1 (S_P's vertices) that
+  // passes no more edges through another layer than x0 had; x1 becomes that
+  // point of the move (crossingGuard() > 0). Returns the fraction.
   double keepMoveOutOfItself(const std::vector<Vec3>& x0, std::vector<Vec3>& x1,
-                             const std::vector<Vec3>* base = nullptr) const;
+                             bool fromRigidMotion = false) const;
   // Whether x1 passes more edges through another layer than x0 does (S_P's
   // vertices; false when crossingGuard() is 0).
   bool passesThroughItself(const std::vector<Vec3>& x0, const std::vector<Vec3>& x1) const;

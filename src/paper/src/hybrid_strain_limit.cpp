@@ -67,24 +67,32 @@ bool HybridSheet::Impl::passesThroughItself(const std::vector<Vec3>& x0,
   return detector.crossings(x1).size() > detector.crossings(x0).size();
 }
 
-// The largest fraction of the move from `base` to x1 (S_P's current mesh)
-// that passes no more edges through another layer than x0 had, by bisection
-// to 1/64 of the move: a discrete stand-in for continuous collision
-// detection (Bridson et al. 2002, Sec. 7) that stops the sheet where it would
-// pass through itself. `base` is x0, or a rigid motion of x0 (which passes no
-// edge through another layer); null means x0. x1 becomes that point of the
-// move; returns the fraction.
+// The largest fraction of the move from x0 to x1 (S_P's current mesh) that
+// passes no more edges through another layer than x0 had, by bisection to
+// 1/64 of the move: a discrete stand-in for continuous collision detection
+// (Bridson et al. 2002, Sec. 7) that stops the sheet where it would pass
+// through itself. With `fromRigidMotion` the move starts instead from the
+// rigid motion that best takes x0 to x1 (Kabsch 1976: fitRigidMotion), which
+// passes no edge through another layer, so only the crossing part of the
+// bending is given up. x1 becomes that point of the move; returns the
+// fraction.
 double HybridSheet::Impl::keepMoveOutOfItself(const std::vector<Vec3>& x0, std::vector<Vec3>& x1,
-                                              const std::vector<Vec3>* base) const {
+                                              bool fromRigidMotion) const {
   const double h = crossingGuard();
   if (!(h > 0.0) || x0.size() != x1.size()) return 1.0;
   sim::SelfContactDetector detector(sp.mesh.triangles, sp.mesh.pattern, h);
   const auto crossings = [&](const std::vector<Vec3>& x) { return detector.crossings(x).size(); };
   const std::size_t allowed = crossings(x0);
   if (crossings(x1) <= allowed) return 1.0;
-  // A rigid motion keeps every crossing as it was up to rounding: checked.
-  const std::vector<Vec3>& from =
-      base != nullptr && base->size() == x0.size() && crossings(*base) <= allowed ? *base : x0;
+  std::vector<Vec3> rigid;
+  if (fromRigidMotion) {
+    const RigidMotion motion = fitRigidMotion(x0, x1);
+    rigid.resize(x0.size());
+    for (std::size_t i = 0; i < x0.size(); ++i) rigid[i] = motion.apply(x0[i]);
+    // A rigid motion keeps every crossing as it was, up to rounding: checked.
+    if (crossings(rigid) > allowed) rigid.clear();
+  }
+  const std::vector<Vec3>& from = rigid.empty() ? x0 : rigid;
   const auto at = [&](double alpha) {
     std::vector<Vec3> x(from.size());
     for (std::size_t i = 0; i < x.size(); ++i) x[i] = from[i] + alpha * (x1[i] - from[i]);
@@ -106,19 +114,12 @@ double HybridSheet::Impl::keepMoveOutOfItself(const std::vector<Vec3>& x0, std::
 // back where it would pass S_P through itself (keepMoveOutOfItself), its
 // velocities to the move it made (docs/CRUMPLING.md "Self-contact in the
 // crumpling samples"). A sheet no handle or grip holds keeps the rigid part
-// of its move (Kabsch 1976: fitRigidMotion) and gives up only the part of
-// its bending that would pass it through itself, so a sheet in free flight
-// falls and turns on instead of standing still in the air.
+// of its move, so a sheet in free flight falls and turns on instead of
+// standing still in the air (docs/CRUMPLING.md "A sheet in free flight").
 double HybridSheet::Impl::keepElasticStepOutOfItself(const std::vector<Vec3>& x0, double dt,
                                                      bool held) {
   std::vector<Vec3> x = elastic->positions();
-  std::vector<Vec3> rigid;
-  if (!held && x.size() == x0.size()) {
-    const RigidMotion motion = fitRigidMotion(x0, x);
-    rigid.resize(x0.size());
-    for (std::size_t i = 0; i < x0.size(); ++i) rigid[i] = motion.apply(x0[i]);
-  }
-  const double alpha = keepMoveOutOfItself(x0, x, rigid.empty() ? nullptr : &rigid);
+  const double alpha = keepMoveOutOfItself(x0, x, !held);
   if (alpha >= 1.0) return alpha;
   std::vector<Vec3> v(x.size());
   for (std::size_t i = 0; i < v.size(); ++i) v[i] = (x[i] - x0[i]) / dt;
