@@ -174,8 +174,20 @@ std::string airParamsProblem(const AirParams& p) {
   return {};
 }
 
+namespace {
+
+// The implicit energy's Hessian with respect to the centroid, at relative
+// velocity u (|u| = speed).
+Mat3 centroidHessianAt(const AirTriangleFrame& f, double h, const Vec3& u, double speed) {
+  Mat3 hc = (f.addedMass / (h * h)) * f.normal * f.normal.transpose();
+  if (speed > 0.0) hc += (f.drag / h) * (speed * Mat3::Identity() + u * u.transpose() / speed);
+  return hc;
+}
+
+}  // namespace
+
 double airTriangleEnergy(const AirTriangleFrame& f, double h, const Vec3& x0, const Vec3& x1,
-                         const Vec3& x2, Vec9* gradient, Mat9* hessian) {
+                         const Vec3& x2, Vec9* gradient, Mat9* hessian, Mat3* centroidHessian) {
   const Vec3 c = (x0 + x1 + x2) / 3.0;
   const Vec3 u = (c - f.centroidStart) / h - f.wind;
   const double speed = u.norm();
@@ -187,10 +199,12 @@ double airTriangleEnergy(const AirTriangleFrame& f, double h, const Vec3& x0, co
     const Vec3 gc = f.drag * speed * u + (f.addedMass * d / h2) * f.normal;
     for (int a = 0; a < 3; ++a) gradient->segment<3>(3 * a) = gc / 3.0;
   }
-  if (hessian) {
-    const Mat3 hc = airCentroidHessian(f, h, x0, x1, x2) / 9.0;
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) hessian->block<3, 3>(3 * a, 3 * b) = hc;
+  if (hessian || centroidHessian) {
+    const Mat3 hc = centroidHessianAt(f, h, u, speed);
+    if (centroidHessian) *centroidHessian = hc;
+    if (hessian)
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) hessian->block<3, 3>(3 * a, 3 * b) = hc / 9.0;
   }
   return energy;
 }
@@ -198,10 +212,7 @@ double airTriangleEnergy(const AirTriangleFrame& f, double h, const Vec3& x0, co
 Mat3 airCentroidHessian(const AirTriangleFrame& f, double h, const Vec3& x0, const Vec3& x1,
                         const Vec3& x2) {
   const Vec3 u = ((x0 + x1 + x2) / 3.0 - f.centroidStart) / h - f.wind;
-  const double speed = u.norm();
-  Mat3 hc = (f.addedMass / (h * h)) * f.normal * f.normal.transpose();
-  if (speed > 0.0) hc += (f.drag / h) * (speed * Mat3::Identity() + u * u.transpose() / speed);
-  return hc;
+  return centroidHessianAt(f, h, u, u.norm());
 }
 
 std::array<Vec3, 3> airExplicitForces(const AirParams& p, const AirExplicitInput& in,

@@ -31,8 +31,9 @@ void ElasticSheet::Impl::addAirGradient(const std::vector<Vec3>& xs, double h, V
     const Vec3& x0 = xs[static_cast<std::size_t>(tri[0])];
     const Vec3& x1 = xs[static_cast<std::size_t>(tri[1])];
     const Vec3& x2 = xs[static_cast<std::size_t>(tri[2])];
-    airTriangleEnergy(frames[t], h, x0, x1, x2, &g);
-    airHess[t] = airCentroidHessian(frames[t], h, x0, x1, x2) / 9.0;
+    Mat3 centroidHessian;
+    airTriangleEnergy(frames[t], h, x0, x1, x2, &g, nullptr, &centroidHessian);
+    airHess[t] = centroidHessian / 9.0;
     for (std::size_t a = 0; a < 3; ++a) {
       const int fi = freeIndex[static_cast<std::size_t>(tri[a])];
       if (fi >= 0) out.segment<3>(3 * fi) += g.segment<3>(3 * static_cast<int>(a));

@@ -317,7 +317,10 @@ ElasticSheet::Impl::LineSearchResult ElasticSheet::Impl::lineSearch(NewtonState&
     s.airMs += msSince(begin);
     return e;
   };
-  const double airNow = air ? airTimed(s.xk) : 0.0;
+  // The air's energy at xk is the accepted trial's of the last line search
+  // when nothing moved xk since (NewtonState::airAtXk).
+  const double airNow = air ? (s.airAtXk ? *s.airAtXk : airTimed(s.xk)) : 0.0;
+  s.airAtXk.reset();
   step = 1.0;
   for (int ls = 0; ls <= kMaxLineSearchHalvings; ++ls, step *= 0.5) {
     applyStep(s, step);
@@ -327,10 +330,13 @@ ElasticSheet::Impl::LineSearchResult ElasticSheet::Impl::lineSearch(NewtonState&
     for (std::size_t k = 0; k < hinges.size(); ++k) deltaV += hingeTrial[k] - hingeEnergy[k];
     if (!contactPlanes.empty() || !faceContacts.empty() || !gripBuffer.empty())
       deltaV += contactEnergy(s.xTrial, s.frictionEps) + gripEnergy(s.xTrial) - contactNow;
-    if (air) deltaV += airTimed(s.xTrial) - airNow;
+    const double airTrial = air ? airTimed(s.xTrial) : 0.0;
+    if (air) deltaV += airTrial - airNow;
     const double deltaPhi = step * slopeQ + 0.5 * step * step * curvature + deltaV;
-    if (std::isfinite(deltaPhi) && deltaPhi <= kArmijo * step * slope)
+    if (std::isfinite(deltaPhi) && deltaPhi <= kArmijo * step * slope) {
+      if (air) s.airAtXk = airTrial;  // xTrial becomes xk
       return LineSearchResult::Accepted;
+    }
   }
   // Within a hundred tolerances of the solution the energy decrease of the
   // Newton step is below Phi's rounding: the iterate is as converged as the
@@ -398,6 +404,7 @@ bool ElasticSheet::Impl::newtonLoop(NewtonState& s, StepStats& stats, std::strin
     if (stepNorm <= tol) {
       applyStep(s, 1.0);
       s.xk.swap(s.xTrial);
+      s.airAtXk.reset();
       converged = true;
       break;
     }
@@ -440,6 +447,7 @@ bool ElasticSheet::Impl::correctAir(NewtonState& s, StepStats& stats, std::strin
   }
   applyStep(s, 1.0);
   s.xk.swap(s.xTrial);
+  s.airAtXk.reset();  // the corrected forces are another energy, at another xk
   // That linearisation errs by about |dx|^2 / edge: below 1e-4 edges for a
   // step under kCorrectorLinearStep edges, far below backward Euler's own
   // error over the step (h^2 |a|); a longer step is polished by Newton.

@@ -257,6 +257,9 @@ struct ElasticSheet::Impl {
     double massDiag = 0.0;     // lumped mass / damping diagonal: 1/h^2 + alpha/h
     double dampScale = 0.0;    // Rayleigh stiffness damping beta / h
     double frictionEps = 0.0;  // kFrictionSpeed h: static friction below it
+    // The air's energy at xk when the last line search computed it there
+    // (its accepted trial), reset whenever xk or the air's terms change.
+    std::optional<double> airAtXk;
     std::vector<Vec3> xTilde, xk, xTrial, disp;
     VecX gradQ, gradV, grad, dx;
   };
