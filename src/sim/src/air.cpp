@@ -209,12 +209,6 @@ double airTriangleEnergy(const AirTriangleFrame& f, double h, const Vec3& x0, co
   return energy;
 }
 
-Mat3 airCentroidHessian(const AirTriangleFrame& f, double h, const Vec3& x0, const Vec3& x1,
-                        const Vec3& x2) {
-  const Vec3 u = ((x0 + x1 + x2) / 3.0 - f.centroidStart) / h - f.wind;
-  return centroidHessianAt(f, h, u, u.norm());
-}
-
 std::array<Vec3, 3> airExplicitForces(const AirParams& p, const AirExplicitInput& in,
                                       std::array<Vec3, 3>* circulation) {
   std::array<Vec3, 3> out{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};

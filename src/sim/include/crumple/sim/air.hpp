@@ -73,14 +73,10 @@ struct AirTriangleFrame {
 // vertices), plus 1/2 addedMass (normal . (centroid - inertiaTarget))^2 / h^2.
 // Gradient and Hessian (positive semi-definite) with respect to the nine
 // coordinates when asked, and the Hessian with respect to the centroid
-// (airCentroidHessian's) in the same pass.
+// (the nine coordinates' Hessian is that block / 9 for every vertex pair).
 double airTriangleEnergy(const AirTriangleFrame& frame, double h, const Vec3& x0, const Vec3& x1,
                          const Vec3& x2, Vec9* gradient = nullptr, Mat9* hessian = nullptr,
                          Mat3* centroidHessian = nullptr);
-// That energy's Hessian with respect to the centroid (its Hessian with
-// respect to the nine coordinates is this block / 9 for every vertex pair).
-Mat3 airCentroidHessian(const AirTriangleFrame& frame, double h, const Vec3& x0, const Vec3& x1,
-                        const Vec3& x2);
 
 // The explicit forces on one triangle's vertices at positions x and
 // velocities v (N): the circulation's lift, translational and rotational
