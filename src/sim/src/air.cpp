@@ -219,12 +219,6 @@ std::array<Vec3, 3> airExplicitForces(const AirParams& p, const AirExplicitInput
   if (!(twiceArea > 0.0)) return out;
   const Vec3 n = big / twiceArea;
   const double area = 0.5 * twiceArea;
-  const Vec3 u = (in.v[0] + in.v[1] + in.v[2]) / 3.0 - in.wind;
-  const double un = u.dot(n);
-  const Vec3 ut = u - un * n;
-  // The normal's rate: the tangential part of d(e1 x e2)/dt over |e1 x e2|.
-  const Vec3 bigRate = (in.v[1] - in.v[0]).cross(e2) + e1.cross(in.v[2] - in.v[0]);
-  const Vec3 nRate = (bigRate - bigRate.dot(n) * n) / twiceArea;
   const double rho = p.density * in.exposure;  // the flow's forces
   Vec3 total = Vec3::Zero();
   // Translational circulation: lift -rho C_T (u.n)(|u|^2 n - (u.n) u)/|u|
@@ -246,6 +240,16 @@ std::array<Vec3, 3> airExplicitForces(const AirParams& p, const AirExplicitInput
   // Added mass m: the air's momentum m (u.n) n changes with the normal, and
   // a changing wind carries m along (d/dt of dT/dv, T = 1/2 m (u.n)^2).
   const double m = p.density * in.openness * p.addedMass * in.chord * area;
+  if (m == 0.0) {  // no added mass (openness 0: the circulation alone)
+    for (Vec3& f : out) f = total / 3.0;
+    return out;
+  }
+  const Vec3 u = (in.v[0] + in.v[1] + in.v[2]) / 3.0 - in.wind;
+  const double un = u.dot(n);
+  const Vec3 ut = u - un * n;
+  // The normal's rate: the tangential part of d(e1 x e2)/dt over |e1 x e2|.
+  const Vec3 bigRate = (in.v[1] - in.v[0]).cross(e2) + e1.cross(in.v[2] - in.v[0]);
+  const Vec3 nRate = (bigRate - bigRate.dot(n) * n) / twiceArea;
   total -= m * (u.dot(nRate) * n + un * nRate);
   total += m * in.windRate.dot(n) * n;
   for (Vec3& f : out) f = total / 3.0;
@@ -381,8 +385,8 @@ void AirModel::beginStep(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
       if (const double twiceArea = big.norm(); twiceArea > 0.0) {
         const Vec3 n = big / twiceArea;
         double open = 0.0;
-        for (const Vec3& side : {n, Vec3(-n)})
-          open += std::clamp(m.shelter.hitDistance(t, centroid[t], side, reach) / reach, 0.0, 1.0);
+        for (const double d : m.shelter.lineHits(t, centroid[t], n, reach))
+          open += std::clamp(d / reach, 0.0, 1.0);
         m.openness[t] = 0.5 * open;
       }
     }

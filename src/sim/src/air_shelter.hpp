@@ -10,6 +10,13 @@
 
 namespace crumple::sim {
 
+// One triangle as the ray test reads it: a corner, the edges from it, and
+// the determinant below which a ray lies in its plane.
+struct ShelterFace {
+  Vec3 origin, e1, e2;
+  double flat = 0.0;
+};
+
 class ShelterCaster {
  public:
   void build(const std::vector<Vec3>& x, const std::vector<std::array<int, 3>>& triangles);
@@ -18,8 +25,14 @@ class ShelterCaster {
   // nearer.
   double hitDistance(std::size_t self, const Vec3& origin, const Vec3& direction,
                      double maxDistance) const;
+  // Both ways along the line through origin with the unit direction, in one
+  // traversal: {hitDistance along direction, hitDistance along -direction}
+  // (bit for bit the two rays' answers).
+  std::array<double, 2> lineHits(std::size_t self, const Vec3& origin, const Vec3& direction,
+                                 double maxDistance) const;
 
  private:
+  bool sharesVertex(std::size_t self, std::size_t other) const;
   struct Node {
     Eigen::AlignedBox3d box;
     int left = -1, right = -1;  // children, or -1 for a leaf
@@ -28,7 +41,8 @@ class ShelterCaster {
   int buildNode(int first, int count, const std::vector<Vec3>& centroids);
   std::vector<Node> nodes_;
   std::vector<int> order_;
-  std::vector<std::array<Vec3, 3>> corners_;
+  std::vector<std::array<Vec3, 3>> corners_;  // for the boxes
+  std::vector<ShelterFace> faces_;            // for the ray tests
   std::vector<std::array<int, 3>> ids_;
 };
 
