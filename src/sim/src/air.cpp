@@ -29,6 +29,12 @@ constexpr double kShelterSpread = 1.0471975511965976;
 struct Pieces {
   std::vector<int> of;        // per triangle
   std::vector<double> chord;  // per piece
+  // The pieces' mass as the sheet lumps it: every vertex's share of its
+  // triangles' pattern areas (a third of each), the piece it is in (-1 in
+  // none), and a vertex of each piece that the sums are taken about.
+  std::vector<double> vertexArea;
+  std::vector<int> vertexPiece;
+  std::vector<int> reference;
 };
 
 Pieces findPieces(const std::vector<std::array<int, 3>>& triangles,
@@ -82,63 +88,72 @@ Pieces findPieces(const std::vector<std::array<int, 3>>& triangles,
     }
     pieces.of.push_back(index[root]);
   }
+  pieces.vertexArea.assign(vertexCount, 0.0);
+  pieces.vertexPiece.assign(vertexCount, -1);
+  pieces.reference.assign(pieces.chord.size(), -1);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const auto& tri = triangles[t];
+    const Vec2 e1 =
+        pattern[static_cast<std::size_t>(tri[1])] - pattern[static_cast<std::size_t>(tri[0])];
+    const Vec2 e2 =
+        pattern[static_cast<std::size_t>(tri[2])] - pattern[static_cast<std::size_t>(tri[0])];
+    const double third = std::abs(e1.x() * e2.y() - e1.y() * e2.x()) / 6.0;
+    const int k = pieces.of[t];
+    for (const int i : tri) {
+      pieces.vertexArea[static_cast<std::size_t>(i)] += third;
+      pieces.vertexPiece[static_cast<std::size_t>(i)] = k;
+    }
+    if (pieces.reference[static_cast<std::size_t>(k)] < 0)
+      pieces.reference[static_cast<std::size_t>(k)] = tri[0];
+  }
   return pieces;
 }
 
-// Every piece's motion as a rigid body at (x, v), uniform density over its
-// triangles: the centre's velocity and the spin that carries its angular
-// momentum (I omega = L about the centre).
-void pieceMotion(const std::vector<std::array<int, 3>>& triangles, const Pieces& pieces,
-                 const std::vector<Vec3>& x, const std::vector<Vec3>& v,
+// Every piece's motion as a rigid body at (x, v), its mass lumped on its
+// vertices as the sheet's is: the centre's velocity and the spin that
+// carries its angular momentum (I omega = L about the centre). The sums are
+// taken about a vertex of the piece and moved to its centre (the parallel
+// axis theorem), in one pass over the vertices.
+void pieceMotion(const Pieces& pieces, const std::vector<Vec3>& x, const std::vector<Vec3>& v,
                  std::vector<Vec3>& velocity, std::vector<Vec3>& spin) {
   const std::size_t np = pieces.chord.size();
-  std::vector<double> mass(np, 0.0);
-  std::vector<Vec3> centre(np, Vec3::Zero());
+  struct Sums {
+    double mass = 0.0;
+    Vec3 moment = Vec3::Zero(), momentum = Vec3::Zero(), angular = Vec3::Zero();
+    Mat3 second = Mat3::Zero();  // sum of m r r^T
+  };
+  std::vector<Sums> sums(np);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const int k = pieces.vertexPiece[i];
+    if (k < 0) continue;
+    Sums& s = sums[static_cast<std::size_t>(k)];
+    const double m = pieces.vertexArea[i];
+    const Vec3 r =
+        x[i] - x[static_cast<std::size_t>(pieces.reference[static_cast<std::size_t>(k)])];
+    s.mass += m;
+    s.moment += m * r;
+    s.momentum += m * v[i];
+    s.angular += m * r.cross(v[i]);
+    s.second.noalias() += m * r * r.transpose();
+  }
   velocity.assign(np, Vec3::Zero());
   spin.assign(np, Vec3::Zero());
-  const auto corners = [&](std::size_t t, const std::vector<Vec3>& f) {
-    return std::array<Vec3, 3>{f[static_cast<std::size_t>(triangles[t][0])],
-                               f[static_cast<std::size_t>(triangles[t][1])],
-                               f[static_cast<std::size_t>(triangles[t][2])]};
-  };
-  std::vector<double> area(triangles.size());
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
-    const auto p = corners(t, x), w = corners(t, v);
-    area[t] = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
-    const auto k = static_cast<std::size_t>(pieces.of[t]);
-    mass[k] += area[t];
-    centre[k] += area[t] * (p[0] + p[1] + p[2]) / 3.0;
-    velocity[k] += area[t] * (w[0] + w[1] + w[2]) / 3.0;
-  }
-  for (std::size_t k = 0; k < np; ++k)
-    if (mass[k] > 0.0) {
-      centre[k] /= mass[k];
-      velocity[k] /= mass[k];
-    }
-  std::vector<Mat3> inertia(np, Mat3::Zero());
-  std::vector<Vec3> momentum(np, Vec3::Zero());
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
-    const auto k = static_cast<std::size_t>(pieces.of[t]);
-    const auto p = corners(t, x), w = corners(t, v);
-    // A uniform triangle's second moment and angular momentum about the
-    // piece's centre: (A/12) sum over its corners plus A at its centroid.
-    const Vec3 c = (p[0] + p[1] + p[2]) / 3.0, vc = (w[0] + w[1] + w[2]) / 3.0;
-    const auto add = [&](const Vec3& r, const Vec3& dv, double weight) {
-      inertia[k] += weight * (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
-      momentum[k] += weight * r.cross(dv);
-    };
-    add(c - centre[k], vc - velocity[k], area[t]);
-    for (std::size_t a = 0; a < 3; ++a) add(p[a] - c, w[a] - vc, area[t] / 12.0);
-  }
   for (std::size_t k = 0; k < np; ++k) {
+    const Sums& s = sums[k];
+    if (!(s.mass > 0.0)) continue;
+    const Vec3 centre = s.moment / s.mass;
+    velocity[k] = s.momentum / s.mass;
+    const Mat3 second = s.second - s.mass * centre * centre.transpose();
+    const Mat3 inertia = second.trace() * Mat3::Identity() - second;
+    const Vec3 momentum = s.angular - s.mass * centre.cross(velocity[k]);
     // A piece with no extent about an axis has no spin about it.
-    const Eigen::SelfAdjointEigenSolver<Mat3> eig(inertia[k]);
+    const Eigen::SelfAdjointEigenSolver<Mat3> eig(inertia);
     const double floor = 1e-9 * eig.eigenvalues().maxCoeff();
     Vec3 omega = Vec3::Zero();
     for (int i = 0; i < 3; ++i)
       if (eig.eigenvalues()(i) > floor)
         omega += eig.eigenvectors().col(i) *
-                 (eig.eigenvectors().col(i).dot(momentum[k]) / eig.eigenvalues()(i));
+                 (eig.eigenvectors().col(i).dot(momentum) / eig.eigenvalues()(i));
     spin[k] = omega;
   }
 }
@@ -298,7 +313,7 @@ void AirModel::Impl::explicitAt(const std::vector<Vec3>& x, const std::vector<Ve
   for (std::vector<Vec3>* out : {all, lift})
     if (out) out->assign(vertexCount, Vec3::Zero());
   std::vector<Vec3> pieceVelocity, pieceSpin;
-  pieceMotion(triangles, pieces, x, v, pieceVelocity, pieceSpin);
+  pieceMotion(pieces, x, v, pieceVelocity, pieceSpin);
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     const auto& tri = triangles[t];
     AirExplicitInput in;
