@@ -113,18 +113,27 @@ void WindField::sampleStep(const std::vector<Vec3>& points, double t0, double t1
     cosDelta[j] = std::cos(delta);
     sinDelta[j] = std::sin(delta);
   }
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const Vec3 carried = points[i] - travel1;
-    Vec3 g0 = Vec3::Zero(), g1 = Vec3::Zero();
-    for (std::size_t j = 0; j < modes_.size(); ++j) {
-      const Mode& m = modes_[j];
-      const double phase = m.wavevector.dot(carried) + m.frequency * t1 + m.phase;
+  // Modes outer, points inner: each point still sums its modes in their
+  // order (the same sums as at()'s), and a mode's numbers stay in registers.
+  const std::size_t n = points.size();
+  std::vector<Vec3> carried(n);
+  for (std::size_t i = 0; i < n; ++i) carried[i] = points[i] - travel1;
+  std::vector<Vec3> g0(n, Vec3::Zero()), g1(n, Vec3::Zero());
+  for (std::size_t j = 0; j < modes_.size(); ++j) {
+    const Mode& m = modes_[j];
+    const double advance = m.frequency * t1;
+    const Vec3 amplitude = m.amplitude;
+    const double cd = cosDelta[j], sd = sinDelta[j];
+    for (std::size_t i = 0; i < n; ++i) {
+      const double phase = m.wavevector.dot(carried[i]) + advance + m.phase;
       const double c = std::cos(phase), s = std::sin(phase);
-      g1 += c * m.amplitude;
-      g0 += (c * cosDelta[j] - s * sinDelta[j]) * m.amplitude;
+      g1[i] += c * amplitude;
+      g0[i] += (c * cd - s * sd) * amplitude;
     }
-    atStart[i] += g0;
-    atEnd[i] += g1;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    atStart[i] += g0[i];
+    atEnd[i] += g1[i];
   }
 }
 
