@@ -1,11 +1,13 @@
 // The wind field (sim/air.hpp, docs/AIR.md "Wind and gusts"): the mean
 // wind's keys and the gusts' random Fourier modes (Kraichnan 1970).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
 #include "crumple/core/rng.hpp"
 #include "crumple/sim/air.hpp"
+#include "sin_cos.hpp"
 
 namespace crumple::sim {
 
@@ -113,27 +115,49 @@ void WindField::sampleStep(const std::vector<Vec3>& points, double t0, double t1
     cosDelta[j] = std::cos(delta);
     sinDelta[j] = std::sin(delta);
   }
-  // Modes outer, points inner: each point still sums its modes in their
-  // order (the same sums as at()'s), and a mode's numbers stay in registers.
+  // Modes outer, points inner, the points' numbers in flat arrays: a mode's
+  // phases, their sines and cosines and the sums are each one loop over the
+  // points (each point still sums its modes in their order).
   const std::size_t n = points.size();
-  std::vector<Vec3> carried(n);
-  for (std::size_t i = 0; i < n; ++i) carried[i] = points[i] - travel1;
-  std::vector<Vec3> g0(n, Vec3::Zero()), g1(n, Vec3::Zero());
+  std::array<std::vector<double>, 3> carried, g0, g1;
+  for (int a = 0; a < 3; ++a) {
+    carried[a].resize(n);
+    g0[a].assign(n, 0.0);
+    g1[a].assign(n, 0.0);
+    for (std::size_t i = 0; i < n; ++i) carried[a][i] = points[i](a) - travel1(a);
+  }
+  std::vector<double> phase(n), sine(n), cosine(n);
   for (std::size_t j = 0; j < modes_.size(); ++j) {
     const Mode& m = modes_[j];
-    const double advance = m.frequency * t1;
-    const Vec3 amplitude = m.amplitude;
-    const double cd = cosDelta[j], sd = sinDelta[j];
+    const double advance = m.frequency * t1 + m.phase;
+    const Vec3 k = m.wavevector;
+    double largest = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
-      const double phase = m.wavevector.dot(carried[i]) + advance + m.phase;
-      const double c = std::cos(phase), s = std::sin(phase);
-      g1[i] += c * amplitude;
-      g0[i] += (c * cd - s * sd) * amplitude;
+      phase[i] = k.x() * carried[0][i] + k.y() * carried[1][i] + k.z() * carried[2][i] + advance;
+      largest = std::max(largest, std::abs(phase[i]));
+    }
+    if (largest <= kMaxReducedPhase) {
+      sinCos(phase.data(), sine.data(), cosine.data(), n);
+    } else {
+      for (std::size_t i = 0; i < n; ++i) {
+        sine[i] = std::sin(phase[i]);
+        cosine[i] = std::cos(phase[i]);
+      }
+    }
+    const double cd = cosDelta[j], sd = sinDelta[j];
+    for (int a = 0; a < 3; ++a) {
+      const double amplitude = m.amplitude(a);
+      double* end = g1[a].data();
+      double* start = g0[a].data();
+      for (std::size_t i = 0; i < n; ++i) {
+        end[i] += cosine[i] * amplitude;
+        start[i] += (cosine[i] * cd - sine[i] * sd) * amplitude;
+      }
     }
   }
   for (std::size_t i = 0; i < n; ++i) {
-    atStart[i] += g0[i];
-    atEnd[i] += g1[i];
+    atStart[i] += Vec3(g0[0][i], g0[1][i], g0[2][i]);
+    atEnd[i] += Vec3(g1[0][i], g1[1][i], g1[2][i]);
   }
 }
 
