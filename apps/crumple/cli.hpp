@@ -26,6 +26,7 @@ struct Args {
   std::string pass = "beauty";
   bool exr = false;
   bool noPng = false;
+  std::string aovs;  // --aov: a comma-separated list (render/aov.hpp)
   bool contactSheet = false;
   bool movie = false;
   bool json = false;

@@ -15,6 +15,7 @@
 #include "crumple/pipeline/export.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/sound.hpp"
+#include "crumple/render/aov.hpp"
 
 namespace crumple::cli {
 
@@ -34,6 +35,16 @@ pipeline::RenderSettings renderSettings(const Args& a) {
     throw InputError("--pass", "'" + a.pass + "' is not a pass (beauty or albedo)");
   r.exr = a.exr;
   r.png = !a.noPng;
+  if (!a.aovs.empty()) {
+    try {
+      r.aovs = render::parseAovList(a.aovs);
+    } catch (const std::invalid_argument& e) {
+      throw InputError("--aov", e.what());
+    }
+    if (r.backend != pipeline::RenderSettings::Backend::Embree)
+      throw InputError("--aov", "AOVs are computed by the embree backend only (--backend embree)");
+    r.exr = true;
+  }
   if (!r.png && !r.exr) throw InputError("--no-png", "needs --exr (otherwise nothing is written)");
   r.contactSheet = a.contactSheet;
   r.movie = a.movie;
@@ -55,7 +66,13 @@ void addRenderOptions(CLI::App* cmd, Args& a) {
                   "beauty (lit) or albedo (the unlit surface colour the two backends agree on)")
       ->capture_default_str();
   cmd->add_flag("--exr", a.exr, "also write NNNN.exr (linear, premultiplied alpha, half floats)");
-  cmd->add_flag("--no-png", a.noPng, "do not write NNNN.png (with --exr)");
+  cmd->add_flag("--no-png", a.noPng, "do not write NNNN.png (with --exr or --aov)");
+  cmd->add_option("--aov", a.aovs,
+                  "embree: AOV layers in NNNN.exr beside RGBA (implies --exr), a comma-separated "
+                  "list of depth (Z), normal (N.XYZ), albedo (albedo.RGB), position (P.XYZ), "
+                  "region (region.RGB: flat, curved, singular-neighbourhood coverage), handle-id "
+                  "(IndexHandle.X), object-id (IndexOB.X: 1 sheet, 2 ground, 3+ props); "
+                  "docs/RENDERING.md \"AOVs\"");
   cmd->add_flag("--contact-sheet", a.contactSheet,
                 "write contact_sheet.png into the shot's folder (beside the cache): a grid of up "
                 "to 36 of the rendered frames, evenly spaced, labelled with their numbers");

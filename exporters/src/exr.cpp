@@ -9,6 +9,7 @@
 #include <ImfHeader.h>
 #include <ImfIO.h>
 #include <ImfInputFile.h>
+#include <ImfOutputFile.h>
 #include <ImfRgba.h>
 #include <ImfRgbaFile.h>
 
@@ -22,6 +23,7 @@
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "crumple/core/error.hpp"
@@ -67,6 +69,67 @@ Imath::half toHalf(float v) {
   return Imath::half(std::clamp(v, -kExrHalfMax, kExrHalfMax));
 }
 
+// Checks `extra` against the image (std::invalid_argument).
+void checkExtraChannels(const std::string& path, const ImageRGBAF& image,
+                        const ImageChannels& extra) {
+  if (extra.width != image.width || extra.height != image.height)
+    throw std::invalid_argument(path + ": EXR channels of " + std::to_string(extra.width) + "x" +
+                                std::to_string(extra.height) + " beside an image of " +
+                                std::to_string(image.width) + "x" + std::to_string(image.height));
+  const std::size_t n = static_cast<std::size_t>(image.width) * image.height;
+  std::vector<std::string> names = {"R", "G", "B", "A"};
+  for (const ImageChannel& c : extra.channels) {
+    if (c.name.empty()) throw std::invalid_argument(path + ": an EXR channel without a name");
+    if (std::find(names.begin(), names.end(), c.name) != names.end())
+      throw std::invalid_argument(path + ": EXR channel '" + c.name + "' given twice");
+    if (c.pixels.size() != n)
+      throw std::invalid_argument(path + ": EXR channel '" + c.name + "' has " +
+                                  std::to_string(c.pixels.size()) + " pixels, not " +
+                                  std::to_string(n));
+    names.push_back(c.name);
+  }
+}
+
+// Encodes the image and `extra` as a complete EXR file in memory (the
+// general OutputFile: RgbaOutputFile writes R, G, B, A only).
+std::vector<char> encodeChannels(const std::string& path, const ImageRGBAF& image,
+                                 const ImageChannels& extra) {
+  const int w = image.width, h = image.height;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  Imf::Header header(w, h);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  header.lineOrder() = Imf::INCREASING_Y;
+  std::vector<std::vector<Imath::half>> halves;
+  halves.reserve(4 + extra.channels.size());
+  Imf::FrameBuffer fb;
+  const Imath::Box2i dw = header.dataWindow();
+  const auto addHalf = [&](const char* name, const float* values, std::size_t stride) {
+    std::vector<Imath::half>& hv = halves.emplace_back(n);
+    for (std::size_t i = 0; i < n; ++i) hv[i] = toHalf(values[i * stride]);
+    header.channels().insert(name, Imf::Channel(Imf::HALF));
+    fb.insert(name, Imf::Slice::Make(Imf::HALF, hv.data(), dw, sizeof(Imath::half),
+                                     sizeof(Imath::half) * static_cast<std::size_t>(w)));
+  };
+  const char* rgba[4] = {"R", "G", "B", "A"};
+  for (int k = 0; k < 4; ++k) addHalf(rgba[k], image.pixels.data() + k, 4);
+  for (const ImageChannel& c : extra.channels) {
+    if (!c.fullFloat) {
+      addHalf(c.name.c_str(), c.pixels.data(), 1);
+      continue;
+    }
+    header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
+    fb.insert(c.name, Imf::Slice::Make(Imf::FLOAT, c.pixels.data(), dw, sizeof(float),
+                                       sizeof(float) * static_cast<std::size_t>(w)));
+  }
+  MemoryOStream stream(path);
+  {
+    Imf::OutputFile file(stream, header, 0);  // one thread, as encode()
+    file.setFrameBuffer(fb);
+    file.writePixels(h);
+  }
+  return stream.bytes();
+}
+
 // Encodes the image as a complete EXR file in memory.
 std::vector<char> encode(const std::string& path, const ImageRGBAF& image) {
   const int w = image.width, h = image.height;
@@ -91,16 +154,10 @@ std::vector<char> encode(const std::string& path, const ImageRGBAF& image) {
 
 }  // namespace
 
-// Atomic EXR write: encode in memory, write PATH.tmp, rename.
-void writeExr(const std::string& path, const ImageRGBAF& image) {
-  checkImageToWrite(path, "EXR", image, "floats");
-  std::vector<char> bytes;
-  try {
-    bytes = encode(path, image);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": cannot encode EXR: " + e.what());
-  }
+namespace {
 
+// Writes the encoded bytes to PATH.tmp and renames it over PATH.
+void writeBytes(const std::string& path, const std::vector<char>& bytes) {
   const std::string tmp = path + ".tmp";
   FilePtr file(std::fopen(tmp.c_str(), "wb"));
   if (!file) throw InputError(path, std::string("cannot write EXR: ") + std::strerror(errno));
@@ -110,18 +167,46 @@ void writeExr(const std::string& path, const ImageRGBAF& image) {
   finishAtomicWrite(file.release(), tmp, path, "EXR", problem);
 }
 
-// EXR read through a float FrameBuffer over the data window.
-ImageRGBAF readExr(const std::string& path) {
+}  // namespace
+
+// Atomic EXR write: encode in memory, write PATH.tmp, rename.
+void writeExr(const std::string& path, const ImageRGBAF& image) {
+  checkImageToWrite(path, "EXR", image, "floats");
+  std::vector<char> bytes;
+  try {
+    bytes = encode(path, image);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": cannot encode EXR: " + e.what());
+  }
+  writeBytes(path, bytes);
+}
+
+void writeExr(const std::string& path, const ImageRGBAF& image, const ImageChannels& extra) {
+  if (extra.channels.empty()) return writeExr(path, image);
+  checkImageToWrite(path, "EXR", image, "floats");
+  checkExtraChannels(path, image, extra);
+  std::vector<char> bytes;
+  try {
+    bytes = encodeChannels(path, image, extra);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": cannot encode EXR: " + e.what());
+  }
+  writeBytes(path, bytes);
+}
+
+namespace {
+
+// Opens an EXR file for reading and checks its data window (at most
+// kMaxPixels) and completeness, then returns body(file, dataWindow, w, h);
+// every failure is an InputError naming the file.
+template <class Body>
+auto readChecked(const std::string& path, Body body) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory, not an EXR");
   if (!std::filesystem::exists(path, ec)) throw InputError(path, "cannot open EXR: no such file");
   try {
     Imf::InputFile file(path.c_str(), 0);
-    const Imf::Header& header = file.header();
-    for (const char* name : {"R", "G", "B"})
-      if (!header.channels().findChannel(name))
-        throw InputError(path, std::string("EXR has no '") + name + "' channel");
-    const Imath::Box2i dw = header.dataWindow();
+    const Imath::Box2i dw = file.header().dataWindow();
     const std::int64_t w = static_cast<std::int64_t>(dw.max.x) - dw.min.x + 1;
     const std::int64_t h = static_cast<std::int64_t>(dw.max.y) - dw.min.y + 1;
     if (w <= 0 || h <= 0 ||
@@ -129,8 +214,23 @@ ImageRGBAF readExr(const std::string& path) {
       throw InputError(path, "EXR data window too large or empty (" + std::to_string(w) + "x" +
                                  std::to_string(h) + ")");
     if (!file.isComplete()) throw InputError(path, "truncated EXR (missing pixel blocks)");
+    return body(file, dw, static_cast<int>(w), static_cast<int>(h));
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(path, std::string("cannot read EXR: ") + e.what());
+  }
+}
 
-    ImageRGBAF image(static_cast<int>(w), static_cast<int>(h));
+}  // namespace
+
+// EXR read through a float FrameBuffer over the data window.
+ImageRGBAF readExr(const std::string& path) {
+  return readChecked(path, [&](Imf::InputFile& file, const Imath::Box2i& dw, int w, int h) {
+    for (const char* name : {"R", "G", "B"})
+      if (!file.header().channels().findChannel(name))
+        throw InputError(path, std::string("EXR has no '") + name + "' channel");
+    ImageRGBAF image(w, h);
     const std::size_t xStride = 4 * sizeof(float);
     const std::size_t yStride = xStride * static_cast<std::size_t>(w);
     Imf::FrameBuffer fb;
@@ -141,11 +241,29 @@ ImageRGBAF readExr(const std::string& path) {
     file.setFrameBuffer(fb);
     file.readPixels(dw.min.y, dw.max.y);
     return image;
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw InputError(path, std::string("cannot read EXR: ") + e.what());
-  }
+  });
+}
+
+ImageChannels readExrChannels(const std::string& path) {
+  return readChecked(path, [&](Imf::InputFile& file, const Imath::Box2i& dw, int w, int h) {
+    ImageChannels out;
+    out.width = w;
+    out.height = h;
+    const Imf::ChannelList& list = file.header().channels();
+    for (auto it = list.begin(); it != list.end(); ++it) {
+      ImageChannel& c = out.channels.emplace_back();
+      c.name = it.name();
+      c.fullFloat = it.channel().type != Imf::HALF;
+      c.pixels.assign(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 0.0f);
+    }
+    Imf::FrameBuffer fb;
+    for (ImageChannel& c : out.channels)
+      fb.insert(c.name, Imf::Slice::Make(Imf::FLOAT, c.pixels.data(), dw, sizeof(float),
+                                         sizeof(float) * static_cast<std::size_t>(w)));
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+    return out;
+  });
 }
 
 }  // namespace crumple::exporters

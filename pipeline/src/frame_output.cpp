@@ -66,6 +66,8 @@ struct FrameRenderer::Impl {
     if (embree && debugStructure)
       throw InputError("--debug-structure",
                        "the structure view is drawn by the osmesa backend only");
+    if (!embree && !settings.aovs.empty())
+      throw InputError("--aov", "AOVs are computed by the embree backend only (--backend embree)");
     render::RendererOptions options;
     options.width = scene.camera.width;
     options.height = scene.camera.height;
@@ -80,6 +82,7 @@ struct FrameRenderer::Impl {
     const FrameView fv = views.build(frame);
     render::FrameSettings frameSettings;
     frameSettings.frame = frame.frame;
+    frameSettings.aovs = settings.aovs;
     std::optional<render::StructureOverlay> overlay;
     if (debugStructure) {
       overlay = structureOverlay(frame);
@@ -88,7 +91,10 @@ struct FrameRenderer::Impl {
     const render::RenderedImage image =
         renderer->render(fv.scene, fv.sheet, frameSettings, settings.pass);
     const fs::path dir(framesDir);
-    if (settings.exr)
+    if (const render::AovImage* aovs = image.aovs())
+      exporters::writeExr((dir / frameFileName(frame.frame, "exr")).string(), image.linear(),
+                          *aovs);
+    else if (settings.exr)
       exporters::writeExr((dir / frameFileName(frame.frame, "exr")).string(), image.linear());
     if (settings.png)
       exporters::writePng((dir / frameFileName(frame.frame)).string(), image.srgb8());

@@ -203,6 +203,8 @@ FrameView FrameViewBuilder::build(const cache::FrameRecord& frame) const {
     }
   }
   fv.scene.sharpVertices = frame.singularVertices;
+  fv.scene.handleVertices = frame.handleVertices;
+  fv.scene.modelledRegions = scene_.model.type == io::ModelSpec::Type::Hybrid;
   fv.sheet = sheetOfFrame(frame);
   // The frame's tear textures (docs/PCACHE.md "TEAR"), checked against its mesh.
   if (auto tears = cache::decodeTearAtlas(frame.extensions)) {

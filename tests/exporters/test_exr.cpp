@@ -233,3 +233,101 @@ TEST_F(Exr, ChannelRequirements) {
 
 }  // namespace
 }  // namespace crumple::exporters
+
+namespace crumple::exporters {
+namespace {
+
+// Channels beside RGBA: a half and a 32-bit one per name kind.
+ImageChannels makeChannels(int w, int h) {
+  ImageChannels c;
+  c.width = w;
+  c.height = h;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  for (const char* name : {"Z", "N.X", "IndexOB.X"}) {
+    ImageChannel& ch = c.channels.emplace_back();
+    ch.name = name;
+    ch.fullFloat = std::string(name) != "N.X";
+    for (std::size_t i = 0; i < n; ++i)
+      ch.pixels.push_back(ch.fullFloat ? 1e10f / static_cast<float>(i + 3) + 0.123456789f
+                                       : 0.3f + 0.001f * static_cast<float>(i));
+  }
+  return c;
+}
+
+class ExrChannels : public test::TempDirTest {};
+
+TEST_F(ExrChannels, ExtraChannelsRoundTripAtTheirPrecision) {
+  const ImageRGBAF img = makeImage(21, 19);  // two ZIP blocks
+  const ImageChannels extra = makeChannels(21, 19);
+  const std::string path = file("layers.exr");
+  writeExr(path, img, extra);
+  const ImageChannels back = readExrChannels(path);
+  ASSERT_EQ(back.width, 21);
+  ASSERT_EQ(back.height, 19);
+  std::vector<std::string> names;
+  for (const ImageChannel& c : back.channels) names.push_back(c.name);
+  // The file's (alphabetical) order.
+  EXPECT_EQ(names, (std::vector<std::string>{"A", "B", "G", "IndexOB.X", "N.X", "R", "Z"}));
+  for (const ImageChannel& c : extra.channels) {
+    const ImageChannel* b = back.find(c.name);
+    ASSERT_NE(b, nullptr) << c.name;
+    EXPECT_EQ(b->fullFloat, c.fullFloat) << c.name;
+    for (std::size_t i = 0; i < c.pixels.size(); ++i) {
+      if (c.fullFloat)
+        ASSERT_EQ(b->pixels[i], c.pixels[i]) << c.name << " " << i;  // 32-bit: exact
+      else
+        expectHalfClose(b->pixels[i], c.pixels[i]);
+    }
+  }
+  // RGBA as writeExr stores it.
+  writeExr(file("plain.exr"), img);
+  const ImageRGBAF plain = readExr(file("plain.exr")), rgba = readExr(path);
+  EXPECT_EQ(plain.pixels, rgba.pixels);
+}
+
+TEST_F(ExrChannels, NoExtraChannelsIsWriteExrByteForByteAndBytesAreDeterministic) {
+  const ImageRGBAF img = makeImage(17, 5);
+  writeExr(file("a.exr"), img);
+  writeExr(file("b.exr"), img, ImageChannels{});
+  EXPECT_EQ(readBytes(file("a.exr")), readBytes(file("b.exr")));
+  writeExr(file("c.exr"), img, makeChannels(17, 5));
+  writeExr(file("d.exr"), img, makeChannels(17, 5));
+  EXPECT_EQ(readBytes(file("c.exr")), readBytes(file("d.exr")));
+  EXPECT_NE(readBytes(file("a.exr")), readBytes(file("c.exr")));
+}
+
+TEST_F(ExrChannels, InconsistentChannelsAreRejectedAndNothingIsWritten) {
+  const ImageRGBAF img = makeImage(8, 4);
+  const auto rejects = [&](ImageChannels extra, const std::string& what) {
+    const std::string path = file("bad.exr");
+    try {
+      writeExr(path, img, extra);
+      ADD_FAILURE() << "accepted: " << what;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_TRUE(contains(e.what(), what)) << e.what();
+    }
+    EXPECT_FALSE(std::filesystem::exists(path));
+  };
+  ImageChannels wrongSize = makeChannels(8, 5);
+  rejects(wrongSize, "8x5");
+  ImageChannels shortChannel = makeChannels(8, 4);
+  shortChannel.channels[1].pixels.pop_back();
+  rejects(shortChannel, "'N.X' has 31 pixels");
+  ImageChannels clash = makeChannels(8, 4);
+  clash.channels[0].name = "R";
+  rejects(clash, "'R' given twice");
+  ImageChannels twice = makeChannels(8, 4);
+  twice.channels[2].name = "Z";
+  rejects(twice, "'Z' given twice");
+  ImageChannels unnamed = makeChannels(8, 4);
+  unnamed.channels[0].name.clear();
+  rejects(unnamed, "without a name");
+}
+
+TEST_F(ExrChannels, ReadingChecksTheFileAsReadExrDoes) {
+  EXPECT_THROW(readExrChannels(file("missing.exr")), InputError);
+  EXPECT_THROW(readExrChannels(dir().string()), InputError);
+}
+
+}  // namespace
+}  // namespace crumple::exporters

@@ -2,6 +2,7 @@
 // bad inputs, progress lines, determinism across thread counts.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 
 #include "crumple/exporters/exr.hpp"
@@ -434,4 +435,55 @@ TEST(Cli, InspectReportsATruncatedCacheAndAFlippedByte) {
   EXPECT_EQ(bad.status, 2) << bad.output;
   EXPECT_NE(bad.output.find("CRC"), std::string::npos) << bad.output;
   EXPECT_NE(bad.output.find("frame "), std::string::npos) << bad.output;
+}
+
+// --aov: the path tracer's AOV layers in the frame's EXR, listed by
+// OpenEXR's own exrheader (installed by scripts/bootstrap.sh), with the
+// crumpling model's regions; refused by the preview and for unknown names.
+TEST(Cli, RenderWithAovsWritesTheLayersACompositorReads) {
+  TempDir tmp;
+  ASSERT_EQ(runCrumple("simulate " + sourcePath("samples/cylinder-fold") + " --out " +
+                       (tmp / "a").string())
+                .status,
+            0);
+  const std::string cache = (tmp / "a/cache.pcache").string();
+  const auto r = runCrumple("render " + cache +
+                            " --frames 70-70 --backend embree --spp 2 --no-png --aov "
+                            "depth,normal,albedo,position,region,handle-id,object-id --out " +
+                            (tmp / "f").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string exr = (tmp / "f/0070.exr").string();
+  EXPECT_FALSE(fs::exists(tmp / "f/0070.png"));
+  const crumple::ImageChannels layers = crumple::exporters::readExrChannels(exr);
+  const std::vector<std::string> expected = {
+      "A",        "B",        "G",        "IndexHandle.X", "IndexOB.X", "N.X", "N.Y",
+      "N.Z",      "P.X",      "P.Y",      "P.Z",           "R",         "Z",   "albedo.B",
+      "albedo.G", "albedo.R", "region.B", "region.G",      "region.R"};
+  std::vector<std::string> names;
+  for (const auto& c : layers.channels) names.push_back(c.name);
+  EXPECT_EQ(names, expected);
+  // The shot's sheet is seen (object 1), curved paper and singular
+  // neighbourhoods at this frame of the bend, and every handle id is one of
+  // the scene's four handles or none.
+  double sheet = 0.0, flat = 0.0, curved = 0.0, singular = 0.0;
+  for (std::size_t i = 0; i < layers.channels[0].pixels.size(); ++i) {
+    sheet += layers.find("IndexOB.X")->pixels[i] == 1.0f;
+    flat += layers.find("region.R")->pixels[i];
+    curved += layers.find("region.G")->pixels[i];
+    singular += layers.find("region.B")->pixels[i];
+    const float h = layers.find("IndexHandle.X")->pixels[i];
+    EXPECT_TRUE(h >= 0.0f && h <= 4.0f && h == std::floor(h)) << h;
+  }
+  EXPECT_GT(sheet, 1000.0);
+  EXPECT_GT(curved, 100.0);
+  EXPECT_GT(singular, 100.0);
+  EXPECT_NEAR(flat + curved + singular, sheet, 0.02 * sheet);  // every sheet pixel labelled
+  const auto header = runCommand("exrheader " + exr);
+  ASSERT_EQ(header.status, 0) << "exrheader (Debian's openexr, scripts/bootstrap.sh): "
+                              << header.output;
+  for (const std::string& name : expected)
+    EXPECT_NE(header.output.find("    " + name + ", "), std::string::npos) << name;
+  EXPECT_EQ(runCrumple("render " + cache + " --frames 40-40 --aov depth").status, 2)
+      << "the preview has no AOVs";
+  EXPECT_EQ(runCrumple("render " + cache + " --backend embree --aov depth,speed").status, 2);
 }

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "crumple/core/parallel.hpp"
+#include "embree/aov_pass.hpp"
 #include "embree/integrator.hpp"
 #include "embree/scene_build.hpp"
 #include "render_geometry.hpp"
@@ -47,11 +48,11 @@ struct EmbreeRenderer::Impl {
 
   // EmbreeRenderer::render.
   ImageRGBAF render(const RenderScene& scene, const mesh::SheetMesh& sheet,
-                    const PathTraceSettings& settings);
+                    const PathTraceSettings& settings, AovImage* aovs);
 };
 
 ImageRGBAF EmbreeRenderer::Impl::render(const RenderScene& scene, const mesh::SheetMesh& sheet,
-                                        const PathTraceSettings& settings) {
+                                        const PathTraceSettings& settings, AovImage* aovs) {
   validateInput(scene, sheet, settings);
   dropped = 0;
   const detail::RenderGeometry geometry =
@@ -64,6 +65,7 @@ ImageRGBAF EmbreeRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
 
   const Camera& cam = scene.camera;
   ImageRGBAF out(cam.width, cam.height);
+  if (aovs) *aovs = pt::makeAovImage(settings.aovs, cam.width, cam.height);
   const int tiles = ((cam.width + pt::kTileSize - 1) / pt::kTileSize) *
                     ((cam.height + pt::kTileSize - 1) / pt::kTileSize);
   const int workers = std::max(1, std::min(threadCount(), tiles));
@@ -73,7 +75,7 @@ ImageRGBAF EmbreeRenderer::Impl::render(const RenderScene& scene, const mesh::Sh
       static_cast<std::size_t>(workers),
       [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
-          droppedBy[i] = pt::renderTiles(f, rtcScene.get(), settings, next, out);
+          droppedBy[i] = pt::renderTiles(f, rtcScene.get(), settings, next, out, aovs);
       },
       1);
   for (const std::uint64_t d : droppedBy) dropped += d;
@@ -86,8 +88,8 @@ EmbreeRenderer::EmbreeRenderer(const RendererOptions& options)
 EmbreeRenderer::~EmbreeRenderer() = default;
 
 ImageRGBAF EmbreeRenderer::render(const RenderScene& scene, const mesh::SheetMesh& sheet,
-                                  const PathTraceSettings& settings) {
-  return impl_->render(scene, sheet, settings);
+                                  const PathTraceSettings& settings, AovImage* aovs) {
+  return impl_->render(scene, sheet, settings, aovs);
 }
 
 RenderedImage EmbreeRenderer::render(const RenderScene& scene, const mesh::SheetMesh& sheet,
@@ -101,7 +103,13 @@ RenderedImage EmbreeRenderer::render(const RenderScene& scene, const mesh::Sheet
   pt.seed = options_.seed;
   pt.frame = settings.frame;
   pt.pass = pass;
-  return RenderedImage(impl_->render(scene, sheet, pt), scene.background);
+  pt.aovs = settings.aovs;
+  if (pt.aovs.empty())
+    return RenderedImage(impl_->render(scene, sheet, pt, nullptr), scene.background);
+  AovImage aovs;
+  RenderedImage image(impl_->render(scene, sheet, pt, &aovs), scene.background);
+  image.setAovs(std::move(aovs));
+  return image;
 }
 
 std::uint64_t EmbreeRenderer::droppedSamples() const { return impl_->dropped; }

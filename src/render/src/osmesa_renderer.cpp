@@ -112,6 +112,8 @@ ImageRGBA8 OsmesaRenderer::render(const RenderScene& scene, const mesh::SheetMes
 
 RenderedImage OsmesaRenderer::render(const RenderScene& scene, const mesh::SheetMesh& sheet,
                                      const FrameSettings& settings, RenderPass pass) {
+  if (!settings.aovs.empty())
+    throw std::invalid_argument("OsmesaRenderer: AOVs are computed by the path tracer only");
   return RenderedImage(impl_->render(scene, sheet, settings.overlay, pass));
 }
 

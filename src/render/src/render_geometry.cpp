@@ -46,6 +46,7 @@ void addTearPatches(const RenderScene& scene, const mesh::SheetMesh& sheet, Rend
     const auto t = static_cast<std::size_t>(patch.triangle);
     for (const mesh::TearPatchTriangle& piece : mesh::tearPatchTriangles(patch, sheet)) {
       PatchPiece& out = g.patchPieces.emplace_back();
+      out.triangle = t;
       for (std::size_t k = 0; k < 3; ++k) {
         const mesh::TearPatchVertex& pv = piece[k];
         PatchCorner& c = out.corners[k];

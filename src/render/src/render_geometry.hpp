@@ -40,7 +40,8 @@ struct PatchCorner {
 // quad), drawn instead of the sheet triangle and cut by the patch's mask.
 struct PatchPiece {
   std::array<PatchCorner, 3> corners;
-  Vec3 faceNormal;  // unit, of its world positions (zero when degenerate)
+  std::size_t triangle = 0;  // the sheet triangle its patch is drawn instead of
+  Vec3 faceNormal;           // unit, of its world positions (zero when degenerate)
 };
 
 // A prop placed for this frame, relative to the origin.

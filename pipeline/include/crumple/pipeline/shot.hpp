@@ -15,6 +15,7 @@
 #include "crumple/io/animation.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
+#include "crumple/render/aov.hpp"
 #include "crumple/render/view.hpp"
 #include "crumple/tear/tearing.hpp"
 
@@ -38,8 +39,11 @@ struct RenderSettings {
   int samplesPerPixel = 16;  // Embree
   int maxBounces = 4;        // Embree
   render::RenderPass pass = render::RenderPass::Beauty;
-  bool png = true;            // NNNN.png (8-bit sRGB, straight alpha)
-  bool exr = false;           // NNNN.exr (linear, premultiplied alpha)
+  bool png = true;   // NNNN.png (8-bit sRGB, straight alpha)
+  bool exr = false;  // NNNN.exr (linear, premultiplied alpha)
+  // Embree: AOV channels in NNNN.exr beside RGBA (render/aov.hpp); not
+  // empty writes the EXR whatever `exr` says.
+  std::vector<render::Aov> aovs;
   bool contactSheet = false;  // contact_sheet.png in the shot's folder (beside the cache)
   bool movie = false;         // preview.mp4 there through ffmpeg, with its sound.wav if any
 };

@@ -37,6 +37,7 @@ struct MeshData {
   std::vector<std::array<std::uint32_t, 3>> triangles;
   std::vector<V3> faceNormals;  // unit, counter-clockwise front; zero when degenerate
   V3 color;                     // ground and props
+  float objectId = 0.0f;        // the AOVs' object id: 1 sheet, 2 ground, 3 + k prop k
 };
 
 // The sheet's shading data per triangle (a mesh triangle, or a piece of a
@@ -46,6 +47,10 @@ struct SheetTri {
   std::array<float, 6> uv;        // texture coordinates of the three corners
   std::array<float, 6> maskUv{};  // tear patches: atlas positions of the corners (texels)
   bool masked = false;            // a tear patch's piece: its mask cuts it too
+  // The AOVs' labels of the sheet triangle it draws (aov_pass.hpp).
+  std::uint8_t region = 0;           // 0 no regions, 1 flat, 2 curved
+  std::uint8_t singularCorners = 0;  // bit k: corner k is a singular vertex (mesh triangles only)
+  std::uint16_t handle = 0;          // the nearest handle in the pattern, 1-based; 0 none
 };
 
 // What the alpha-cut filters and the paper shading read.
@@ -110,6 +115,7 @@ struct FrameData {
   CameraData camera;
   int maxBounces = 0;
   int spp = 1;
+  Vec3 origin = Vec3::Zero();  // world position of the relative origin (the AOVs' P)
 };
 
 // The offset of a ray origin off a surface at p (scene scale plus float

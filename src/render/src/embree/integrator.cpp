@@ -19,14 +19,12 @@
 #include <cmath>
 #include <cstddef>
 
+#include "aov_pass.hpp"
 #include "crumple/core/rng.hpp"
 #include "pt_sampler.hpp"
 
 namespace crumple::render::pt {
 
-namespace {
-
-// The shading point of a hit (ray direction dir, unit).
 Surface makeSurface(const FrameData& f, const RTCRayHit& rh, V3 dir) {
   const MeshData& m = f.meshes[rh.hit.geomID];
   const unsigned prim = rh.hit.primID;
@@ -61,6 +59,8 @@ Surface makeSurface(const FrameData& f, const RTCRayHit& rh, V3 dir) {
   }
   return s;
 }
+
+namespace {
 
 // The first hit's albedo only (the albedo pass).
 V3 surfaceAlbedo(const FrameData& f, const RTCRayHit& rh, V3 dir) {
@@ -320,8 +320,10 @@ class Tracer {
 }  // namespace
 
 std::uint64_t renderTiles(const FrameData& f, RTCScene scene, const PathTraceSettings& settings,
-                          std::atomic<int>& next, ImageRGBAF& out) {
+                          std::atomic<int>& next, ImageRGBAF& out, AovImage* aovs) {
   Tracer tracer(f, scene);
+  AovPixel aovPixel(f);
+  const bool withAovs = aovs != nullptr && !settings.aovs.empty();
   const int w = out.width, h = out.height;
   const int tilesX = (w + kTileSize - 1) / kTileSize;
   const int tilesY = (h + kTileSize - 1) / kTileSize;
@@ -340,6 +342,7 @@ std::uint64_t renderTiles(const FrameData& f, RTCScene scene, const PathTraceSet
         PixelSampler smp{rng.bits(pixelIndex), 0};
         double r = 0.0, g = 0.0, b = 0.0;
         int hits = 0;
+        if (withAovs) aovPixel.reset();
         // The camera rays of the pixel in batches, then their paths one by one.
         for (int s0 = 0; s0 < f.spp; s0 += kCameraBatch) {
           const int count = std::min(kCameraBatch, f.spp - s0);
@@ -358,6 +361,7 @@ std::uint64_t renderTiles(const FrameData& f, RTCScene scene, const PathTraceSet
             ++hits;
             smp.index = static_cast<std::uint32_t>(s0 + i);
             const V3 dir{rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z};
+            if (withAovs) aovPixel.add(rh, dir);
             const V3 c = albedoPass ? surfaceAlbedo(f, rh, dir) : tracer.radiance(rh, dir, smp);
             if (!isFinite(c)) {
               ++dropped;
@@ -368,6 +372,8 @@ std::uint64_t renderTiles(const FrameData& f, RTCScene scene, const PathTraceSet
             b += c.z;
           }
         }
+        if (withAovs)
+          aovPixel.store(settings.aovs, static_cast<std::size_t>(pixelIndex), f.spp, *aovs);
         float* p = out.at(x, y);
         p[0] = static_cast<float>(r * invSpp);
         p[1] = static_cast<float>(g * invSpp);

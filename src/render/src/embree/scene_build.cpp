@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "aov_pass.hpp"
 #include "crumple/core/parallel.hpp"
 
 namespace crumple::render::pt {
@@ -155,6 +156,27 @@ MeshData sheetMesh(const mesh::SheetMesh& sheet, const detail::RenderGeometry& g
   return m;
 }
 
+// The AOVs' labels of the sheet's drawn triangles and tear-patch pieces, in
+// look.tris order (sheetMesh's), from their sheet triangles'
+// (aov_pass.hpp). A patch's pieces have other corners than their triangle:
+// they take its region and handle, and no singular corners.
+void labelSheetTriangles(const RenderScene& scene, const mesh::SheetMesh& sheet,
+                         const detail::RenderGeometry& g, SheetLook& look) {
+  const std::vector<std::uint8_t> regions = sheetTriangleRegions(sheet, scene.modelledRegions);
+  const std::vector<std::uint8_t> corners = singularCorners(sheet, scene.sharpVertices);
+  const std::vector<std::uint16_t> handles = nearestHandles(sheet, scene.handleVertices);
+  std::size_t i = 0;
+  for (const std::size_t t : g.drawnTriangles) {
+    look.tris[i].region = regions[t];
+    look.tris[i].singularCorners = regions[t] > 0 ? corners[t] : 0;
+    look.tris[i++].handle = handles[t];
+  }
+  for (const detail::PatchPiece& piece : g.patchPieces) {
+    look.tris[i].region = regions[piece.triangle];
+    look.tris[i++].handle = handles[piece.triangle];
+  }
+}
+
 // The ground square's Embree mesh (front +Y).
 MeshData groundMesh(const std::array<Vec3, 4>& corners, const Vec3& color) {
   MeshData m;
@@ -264,10 +286,21 @@ FrameData buildFrameData(const RenderScene& scene, const mesh::SheetMesh& sheet,
   f.sheet.back = toV3(scene.paper.backColor);
   f.sheet.transmittance = static_cast<float>(scene.paper.transmittance);
   f.sheet.tears = &scene.tears;
-  if (!sheet.triangles.empty()) f.meshes.push_back(sheetMesh(sheet, g, f.sheet));
-  if (g.ground) f.meshes.push_back(groundMesh(*g.ground, scene.ground.color));
-  for (const detail::PropGeometry& prop : g.props)
-    if (!prop.mesh->triangles.empty()) f.meshes.push_back(propMesh(prop));
+  if (!sheet.triangles.empty()) {
+    f.meshes.push_back(sheetMesh(sheet, g, f.sheet));
+    f.meshes.back().objectId = 1.0f;
+    if (!settings.aovs.empty()) labelSheetTriangles(scene, sheet, g, f.sheet);
+  }
+  if (g.ground) {
+    f.meshes.push_back(groundMesh(*g.ground, scene.ground.color));
+    f.meshes.back().objectId = 2.0f;
+  }
+  for (std::size_t k = 0; k < g.props.size(); ++k)
+    if (!g.props[k].mesh->triangles.empty()) {
+      f.meshes.push_back(propMesh(g.props[k]));
+      f.meshes.back().objectId = static_cast<float>(3 + k);
+    }
+  f.origin = g.origin;
 
   makeLights(g.lights, f);
   const Vec3 env = scene.environment.color * scene.environment.intensity;

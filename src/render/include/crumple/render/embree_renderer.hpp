@@ -22,9 +22,11 @@
 // (0, 0, 0, 0). Beauty: radiance; Albedo: the first hit's albedo.
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "crumple/core/image.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
+#include "crumple/render/aov.hpp"
 #include "crumple/render/renderer.hpp"
 #include "crumple/render/view.hpp"
 
@@ -38,6 +40,7 @@ struct PathTraceSettings {
   std::uint64_t seed = 0;    // with frame: keys the per-pixel sample streams
   int frame = 0;
   RenderPass pass = RenderPass::Beauty;
+  std::vector<Aov> aovs;  // computed from the same camera rays (aov.hpp); each once
 };
 
 class EmbreeRenderer final : public Renderer {
@@ -54,13 +57,15 @@ class EmbreeRenderer final : public Renderer {
   // OsmesaRenderer does) and std::runtime_error on an Embree failure. No NaN
   // or Inf is ever written: a non-finite sample is dropped and counted
   // (droppedSamples()).
+  // With `aovs` not null, settings.aovs' channels go there (makeAovImage's
+  // order: aov.hpp).
   ImageRGBAF render(const RenderScene& scene, const mesh::SheetMesh& sheet,
-                    const PathTraceSettings& settings);
+                    const PathTraceSettings& settings, AovImage* aovs = nullptr);
 
   // The Renderer interface: the render above with the options' settings and
-  // the frame's number and pass; the rendered image's linear() is its image
-  // and srgb8() toSrgb8 of it on the scene's background. Throws
-  // std::invalid_argument on a non-empty overlay.
+  // the frame's number, pass and AOVs; the rendered image's linear() is its
+  // image, srgb8() toSrgb8 of it on the scene's background and aovs() the
+  // AOVs. Throws std::invalid_argument on a non-empty overlay.
   RenderedImage render(const RenderScene& scene, const mesh::SheetMesh& sheet,
                        const FrameSettings& settings, RenderPass pass) override;
 

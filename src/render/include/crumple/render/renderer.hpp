@@ -12,9 +12,12 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <utility>
+#include <vector>
 
 #include "crumple/core/image.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
+#include "crumple/render/aov.hpp"
 #include "crumple/render/view.hpp"
 
 namespace crumple::render {
@@ -39,6 +42,9 @@ struct FrameSettings {
   // The structure view drawn over the sheet (StructureOverlay in view.hpp):
   // the rasteriser's only; the path tracer rejects a non-empty one.
   const StructureOverlay* overlay = nullptr;
+  // The AOVs to compute beside the image (aov.hpp), each once: the path
+  // tracer's only; the rasteriser rejects a non-empty list.
+  std::vector<Aov> aovs;
 };
 
 // One rendered frame, whatever the backend: a linear float image (EXR) and
@@ -62,10 +68,15 @@ class RenderedImage {
   // image byte for byte, or toSrgb8(linear(), background) of its float one.
   const ImageRGBA8& srgb8() const;
 
+  // The frame's AOVs when FrameSettings asked for some, else nullptr.
+  const AovImage* aovs() const { return aovs_ ? &*aovs_ : nullptr; }
+  void setAovs(AovImage aovs) { aovs_ = std::move(aovs); }
+
  private:
   Vec3 background_ = Vec3::Zero();
   mutable std::optional<ImageRGBAF> linear_;
   mutable std::optional<ImageRGBA8> srgb8_;
+  std::optional<AovImage> aovs_;
 };
 
 // A renderer: one frame at a time (not thread-safe; one per thread).

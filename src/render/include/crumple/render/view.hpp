@@ -187,6 +187,12 @@ struct RenderScene {
   // This frame's sharp vertices of the sheet (the model's singular vertices):
   // shading normals are not smoothed around them.
   std::vector<int> sharpVertices;
+  // The sheet vertex each handle holds this frame, in the scene's handle
+  // order (-1: released): the handle-id AOV's partition (aov.hpp).
+  std::vector<int> handleVertices;
+  // True when the sheet's regions are the crumpling model's flat and curved
+  // regions (the region AOV's labels); the elastic model's one region is not.
+  bool modelledRegions = false;
   // This frame's tear textures (docs/RENDERING.md "Tears"; thesis 3.3.4):
   // each patch is drawn instead of its triangle, the triangle and its
   // support quads (mesh::tearPatchTriangles), and the paper is cut where the
