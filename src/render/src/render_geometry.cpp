@@ -61,39 +61,34 @@ void addTearPatches(const RenderScene& scene, const mesh::SheetMesh& sheet, Rend
   }
 }
 
-// The props relative to the origin, with their flat face normals.
-void addProps(const RenderScene& scene, RenderGeometry& g) {
+// The props relative to the origin, with their flat face normals; at
+// motion-blur time step `step` (when not kNoStep) those of them that move
+// are at their positions of that step.
+void addProps(const RenderScene& scene, RenderGeometry& g, std::size_t step) {
   g.props.reserve(scene.props.size());
   for (const PropMesh& prop : scene.props) {
     PropGeometry& p = g.props.emplace_back();
     p.mesh = &prop;
-    p.vertices.reserve(prop.vertices.size());
-    for (const Vec3& v : prop.vertices) p.vertices.push_back(toFloat3(v - g.origin));
+    const std::vector<Vec3>& at =
+        step != kNoStep && !prop.motion.empty() ? prop.motion[step] : prop.vertices;
+    p.vertices.reserve(at.size());
+    for (const Vec3& v : at) p.vertices.push_back(toFloat3(v - g.origin));
     p.faceNormals.reserve(prop.triangles.size());
     for (const auto& t : prop.triangles)
-      p.faceNormals.push_back(
-          toFloat3(unitNormal(prop.vertices[static_cast<std::size_t>(t[0])] - g.origin,
-                              prop.vertices[static_cast<std::size_t>(t[1])] - g.origin,
-                              prop.vertices[static_cast<std::size_t>(t[2])] - g.origin)));
+      p.faceNormals.push_back(toFloat3(unitNormal(at[static_cast<std::size_t>(t[0])] - g.origin,
+                                                  at[static_cast<std::size_t>(t[1])] - g.origin,
+                                                  at[static_cast<std::size_t>(t[2])] - g.origin)));
   }
 }
 
-}  // namespace
-
-RenderGeometry buildRenderGeometry(const RenderScene& scene, const mesh::SheetMesh& sheet,
-                                   bool withTearPatches) {
+// buildRenderGeometry about a given origin, at motion-blur time step `step`
+// (kNoStep: the scene's own positions).
+RenderGeometry buildAbout(const RenderScene& scene, const mesh::SheetMesh& sheet,
+                          bool withTearPatches, const Vec3& origin, double sheetSize,
+                          std::size_t step) {
   RenderGeometry g;
-  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
-  Vec3 hi = -lo;
-  for (const Vec3& p : sheet.positions) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  if (!sheet.positions.empty()) {
-    g.origin = 0.5 * (lo + hi);
-    g.sheetSize = (hi - lo).norm();
-  }
-
+  g.origin = origin;
+  g.sheetSize = sheetSize;
   g.camera = scene.camera;
   g.camera.position -= g.origin;
   g.lights = scene.lights;
@@ -107,7 +102,7 @@ RenderGeometry buildRenderGeometry(const RenderScene& scene, const mesh::SheetMe
       replaced[static_cast<std::size_t>(p.triangle)] = 1;
   addSheet(scene, sheet, replaced, g);
   if (torn) addTearPatches(scene, sheet, g);
-  addProps(scene, g);
+  addProps(scene, g, step);
 
   if (scene.ground.enabled) {
     const double h = 0.5 * scene.ground.size;
@@ -115,6 +110,31 @@ RenderGeometry buildRenderGeometry(const RenderScene& scene, const mesh::SheetMe
     g.ground = std::array<Vec3, 4>{Vec3(-h, y, h), Vec3(h, y, h), Vec3(h, y, -h), Vec3(-h, y, -h)};
   }
   return g;
+}
+
+}  // namespace
+
+RenderGeometry buildRenderGeometry(const RenderScene& scene, const mesh::SheetMesh& sheet,
+                                   bool withTearPatches) {
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  Vec3 hi = -lo;
+  for (const Vec3& p : sheet.positions) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const bool any = !sheet.positions.empty();
+  return buildAbout(scene, sheet, withTearPatches, any ? Vec3(0.5 * (lo + hi)) : Vec3(Vec3::Zero()),
+                    any ? (hi - lo).norm() : 0.0, kNoStep);
+}
+
+RenderGeometry buildStepGeometry(const RenderScene& scene, const mesh::SheetMesh& sheet,
+                                 bool withTearPatches, const RenderGeometry& base,
+                                 std::size_t step) {
+  if (scene.sheetMotion.empty())
+    return buildAbout(scene, sheet, withTearPatches, base.origin, base.sheetSize, step);
+  mesh::SheetMesh moved = sheet;
+  moved.positions = scene.sheetMotion[step];
+  return buildAbout(scene, moved, withTearPatches, base.origin, base.sheetSize, step);
 }
 
 std::vector<Vec3> faceNormals(const std::vector<Vec3>& positions,

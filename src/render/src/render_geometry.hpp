@@ -85,6 +85,17 @@ struct RenderGeometry {
 RenderGeometry buildRenderGeometry(const RenderScene& scene, const mesh::SheetMesh& sheet,
                                    bool withTearPatches);
 
+// No motion-blur time step: the scene's own positions.
+inline constexpr std::size_t kNoStep = static_cast<std::size_t>(-1);
+
+// The render geometry at motion-blur time step `step` (< motionSteps()):
+// the sheet at scene.sheetMotion[step] (its own positions when that is
+// empty), the props at their motion[step] (when they move), about base's
+// origin so that every step shares one frame of reference.
+RenderGeometry buildStepGeometry(const RenderScene& scene, const mesh::SheetMesh& sheet,
+                                 bool withTearPatches, const RenderGeometry& base,
+                                 std::size_t step);
+
 // Unit face normals of a triangle mesh (zero for a degenerate triangle): the
 // face normals shadingNormals smooths.
 std::vector<Vec3> faceNormals(const std::vector<Vec3>& positions,

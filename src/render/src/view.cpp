@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -222,6 +223,40 @@ Vec4 sampleTexture(const ImageRGBA8& texture, const Vec2& uv) {
          ay * ((1.0 - ax) * texel(x0, y1) + ax * texel(x1, y1));
 }
 
+std::size_t RenderScene::motionSteps() const {
+  std::size_t steps = sheetMotion.size();
+  for (const PropMesh& prop : props) steps = std::max(steps, prop.motion.size());
+  return steps;
+}
+
+namespace {
+
+// The motion-blur time steps of validateRenderInput: every non-empty list of
+// the same count >= 2, each step as many finite positions as its mesh has.
+void validateMotion(const RenderScene& scene, const mesh::SheetMesh& sheet,
+                    const std::function<void(const std::string&)>& invalid) {
+  const std::size_t steps = scene.motionSteps();
+  const auto check = [&](const std::vector<std::vector<Vec3>>& motion, std::size_t count,
+                         const std::string& what) {
+    if (motion.empty()) return;
+    if (motion.size() != steps || steps < 2)
+      invalid(what + " has " + std::to_string(motion.size()) + " motion steps, not " +
+              (steps < 2 ? std::string("at least 2") : std::to_string(steps)));
+    for (const auto& step : motion) {
+      if (step.size() != count)
+        invalid(what + " motion step has " + std::to_string(step.size()) + " positions, not " +
+                std::to_string(count));
+      for (const Vec3& p : step)
+        if (!p.allFinite()) invalid(what + " motion step has a non-finite position");
+    }
+  };
+  check(scene.sheetMotion, sheet.positions.size(), "sheet");
+  for (const PropMesh& prop : scene.props)
+    check(prop.motion, prop.vertices.size(), "prop '" + prop.name + "'");
+}
+
+}  // namespace
+
 void validateRenderInput(const RenderScene& scene, const mesh::SheetMesh& sheet, const char* who) {
   const auto invalid = [who](const std::string& what) {
     throw std::invalid_argument(std::string(who) + ": " + what);
@@ -289,6 +324,7 @@ void validateRenderInput(const RenderScene& scene, const mesh::SheetMesh& sheet,
       for (const int v : t)
         if (v < 0 || v >= nv) invalid("prop '" + prop.name + "' triangle index out of range");
   }
+  validateMotion(scene, sheet, invalid);
 }
 
 const ImageRGBA8& defaultPaperTexture() {

@@ -38,6 +38,10 @@ struct MeshData {
   std::vector<V3> faceNormals;  // unit, counter-clockwise front; zero when degenerate
   V3 color;                     // ground and props
   float objectId = 0.0f;        // the AOVs' object id: 1 sheet, 2 ground, 3 + k prop k
+  // Motion blur: the vertices and face normals at each time step (vertices
+  // padded as `vertices`); empty when the mesh is still over the shutter.
+  std::vector<std::vector<V3>> steps;
+  std::vector<std::vector<V3>> stepFaceNormals;
 };
 
 // The sheet's shading data per triangle (a mesh triangle, or a piece of a
@@ -60,6 +64,9 @@ struct SheetLook {
   std::vector<SheetTri> tris;
   V3 front, back;
   float transmittance = 0.0f;
+  // Motion blur: the shading normals of tris at each time step (empty when
+  // the sheet is still).
+  std::vector<std::vector<std::array<V3, 3>>> stepNormals;
 };
 
 // Coordinates at barycentrics (u, v) of a triangle's three corners.
@@ -116,6 +123,11 @@ struct FrameData {
   int maxBounces = 0;
   int spp = 1;
   Vec3 origin = Vec3::Zero();  // world position of the relative origin (the AOVs' P)
+  // Motion blur: the time steps over the shutter (0: nothing moves, camera
+  // rays at time 0); then each camera ray draws its time from sample pair
+  // 2, and the first path vertex's pairs start at cameraPairs.
+  std::size_t motionSteps = 0;
+  std::uint32_t cameraPairs = 2;
 };
 
 // The offset of a ray origin off a surface at p (scene scale plus float

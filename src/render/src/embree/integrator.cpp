@@ -25,15 +25,53 @@
 
 namespace crumple::render::pt {
 
-Surface makeSurface(const FrameData& f, const RTCRayHit& rh, V3 dir) {
+namespace {
+
+// A triangle of a mesh at shutter time `time` (motion blur: between the two
+// time steps around it, linearly, as Embree moves it): its corners, its
+// face normal (zero when degenerate) and, for the sheet's shading normals,
+// the step and the weight of the next one.
+struct TriangleAt {
+  V3 a, b, c, ng;
+  std::size_t step = 0;
+  float next = 0.0f;
+};
+
+TriangleAt triangleAt(const MeshData& m, unsigned prim, float time) {
+  const auto& tri = m.triangles[prim];
+  TriangleAt t;
+  if (m.steps.empty()) {
+    t.a = m.vertices[tri[0]];
+    t.b = m.vertices[tri[1]];
+    t.c = m.vertices[tri[2]];
+    t.ng = m.faceNormals[prim];
+    return t;
+  }
+  const float x = time * static_cast<float>(m.steps.size() - 1);
+  t.step = std::min(static_cast<std::size_t>(std::max(x, 0.0f)), m.steps.size() - 2);
+  t.next = x - static_cast<float>(t.step);
+  const std::vector<V3>& s0 = m.steps[t.step];
+  const std::vector<V3>& s1 = m.steps[t.step + 1];
+  const float w0 = 1.0f - t.next, w1 = t.next;
+  t.a = s0[tri[0]] * w0 + s1[tri[0]] * w1;
+  t.b = s0[tri[1]] * w0 + s1[tri[1]] * w1;
+  t.c = s0[tri[2]] * w0 + s1[tri[2]] * w1;
+  const V3 n = cross(t.b - t.a, t.c - t.a);
+  const float len = length(n);
+  t.ng = len > 0.0f ? n * (1.0f / len) : V3{};
+  return t;
+}
+
+}  // namespace
+
+Surface makeSurface(const FrameData& f, const RTCRayHit& rh, V3 dir, float time) {
   const MeshData& m = f.meshes[rh.hit.geomID];
   const unsigned prim = rh.hit.primID;
-  const auto& tri = m.triangles[prim];
   const float u = rh.hit.u, v = rh.hit.v;
-  const V3 a = m.vertices[tri[0]], b = m.vertices[tri[1]], c = m.vertices[tri[2]];
+  const TriangleAt tri = triangleAt(m, prim, time);
   Surface s;
-  s.p = a + (b - a) * u + (c - a) * v;
-  V3 ng = m.faceNormals[prim];
+  s.p = tri.a + (tri.b - tri.a) * u + (tri.c - tri.a) * v;
+  V3 ng = tri.ng;
   if (isBlack(ng)) {
     // Degenerate in double, hit in float: Embree's normal (any orientation).
     ng = normalize(V3{rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z});
@@ -44,7 +82,14 @@ Surface makeSurface(const FrameData& f, const RTCRayHit& rh, V3 dir) {
     const SheetLook& look = f.sheet;
     const SheetTri& t = look.tris[prim];
     const float w = 1.0f - u - v;
-    const V3 n = t.normals[0] * w + t.normals[1] * u + t.normals[2] * v;
+    V3 n = t.normals[0] * w + t.normals[1] * u + t.normals[2] * v;
+    if (!look.stepNormals.empty()) {
+      const auto& n0 = look.stepNormals[tri.step][prim];
+      const auto& n1 = look.stepNormals[tri.step + 1][prim];
+      const float w1 = tri.next, w0 = 1.0f - w1;
+      n = (n0[0] * w0 + n1[0] * w1) * w + (n0[1] * w0 + n1[1] * w1) * u +
+          (n0[2] * w0 + n1[2] * w1) * v;
+    }
     const float len = length(n);
     s.ns = len > 1e-4f ? n * ((front ? 1.0f : -1.0f) / len) : s.ng;
     const Vec4 tex = sampleTexture(*look.texture, sheetUv(t, u, v));
@@ -130,13 +175,13 @@ class Tracer {
   }
 
   // Closest hit along a ray (geomID RTC_INVALID_GEOMETRY_ID on a miss).
-  void intersect(V3 org, V3 dir, RTCRayHit& rh) {
-    setRay(org, dir, rh);
+  void intersect(V3 org, V3 dir, float time, RTCRayHit& rh) {
+    setRay(org, dir, time, rh);
     rtcIntersect1(scene_, &incoherent_, &rh);
   }
 
   // Initialises a ray from org along dir, t in [0, inf), with no hit.
-  static void setRay(V3 org, V3 dir, RTCRayHit& rh) {
+  static void setRay(V3 org, V3 dir, float time, RTCRayHit& rh) {
     rh.ray.org_x = org.x;
     rh.ray.org_y = org.y;
     rh.ray.org_z = org.z;
@@ -144,7 +189,7 @@ class Tracer {
     rh.ray.dir_x = dir.x;
     rh.ray.dir_y = dir.y;
     rh.ray.dir_z = dir.z;
-    rh.ray.time = 0.0f;
+    rh.ray.time = time;
     rh.ray.tfar = kInf;
     rh.ray.mask = 0xFFFFFFFFu;
     rh.ray.id = 0;
@@ -155,7 +200,7 @@ class Tracer {
   }
 
   // True when nothing blocks the segment org + t dir, t in [0, tfar].
-  bool visible(V3 org, V3 dir, float tfar) {
+  bool visible(V3 org, V3 dir, float tfar, float time) {
     RTCRay r;
     r.org_x = org.x;
     r.org_y = org.y;
@@ -164,7 +209,7 @@ class Tracer {
     r.dir_x = dir.x;
     r.dir_y = dir.y;
     r.dir_z = dir.z;
-    r.time = 0.0f;
+    r.time = time;
     r.tfar = tfar;
     r.mask = 0xFFFFFFFFu;
     r.id = 0;
@@ -176,14 +221,15 @@ class Tracer {
   // Radiance arriving along a camera ray that hit `first` (premultiplied
   // path contribution; may be non-finite, the caller checks).
   V3 radiance(const RTCRayHit& first, V3 dir, const PixelSampler& smp) {
+    const float time = first.ray.time;  // the camera ray's: the whole path's
     V3 result{}, beta{1.0f, 1.0f, 1.0f};
-    Surface s = makeSurface(f_, first, dir);
+    Surface s = makeSurface(f_, first, dir, time);
     const bool needEmissionRay =
         f_.hasEnvironment || !f_.sunLights.empty() || !f_.areaLights.empty();
     for (int k = 0;; ++k) {
-      const std::uint32_t base = 2 + static_cast<std::uint32_t>(k) * f_.pairsPerVertex;
+      const std::uint32_t base = f_.cameraPairs + static_cast<std::uint32_t>(k) * f_.pairsPerVertex;
       const float eps = originOffset(f_, s.p);
-      result += beta * directLight(s, eps, smp, base);
+      result += beta * directLight(s, eps, smp, base, time);
 
       const bool last = k >= f_.maxBounces;
       if (last && !needEmissionRay) break;
@@ -217,7 +263,7 @@ class Tracer {
 
       const V3 org = s.p + (cg > 0.0f ? s.ng : -s.ng) * eps;
       RTCRayHit rh;
-      intersect(org, wi, rh);
+      intersect(org, wi, time, rh);
       const bool miss = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID;
       const float tHit = miss ? kInf : rh.ray.tfar;
       // Area lights crossed before the hit (they are transparent).
@@ -243,14 +289,15 @@ class Tracer {
         break;
       }
       if (last) break;
-      s = makeSurface(f_, rh, wi);
+      s = makeSurface(f_, rh, wi, time);
     }
     return result;
   }
 
  private:
   // Next-event estimation at s for every light (pairs from `base`).
-  V3 directLight(const Surface& s, float eps, const PixelSampler& smp, std::uint32_t base) {
+  V3 directLight(const Surface& s, float eps, const PixelSampler& smp, std::uint32_t base,
+                 float time) {
     V3 sum{};
     for (const LightData& l : f_.lights) {
       V3 wi, li;
@@ -305,7 +352,7 @@ class Tracer {
       if (!(weight > 0.0f)) continue;
       const V3 org = s.p + (dot(wi, s.ng) > 0.0f ? s.ng : -s.ng) * eps;
       const float tfar = dist == kInf ? kInf : dist - 2.0f * eps;
-      if (!(tfar > 0.0f) || !visible(org, wi, tfar)) continue;
+      if (!(tfar > 0.0f) || !visible(org, wi, tfar, time)) continue;
       sum += fcos * li * weight;
     }
     return sum;
@@ -352,7 +399,9 @@ std::uint64_t renderTiles(const FrameData& f, RTCScene scene, const PathTraceSet
             V3 org, dir;
             tracer.cameraRay(static_cast<float>(x) + pix.x, static_cast<float>(y) + pix.y,
                              lens ? smp.get(1) : Sample2{0.5f, 0.5f}, org, dir);
-            Tracer::setRay(org, dir, batch[static_cast<std::size_t>(i)]);
+            // Motion blur: the ray's time in the shutter, from its own pair.
+            const float time = f.motionSteps > 0 ? smp.get(2).x : 0.0f;
+            Tracer::setRay(org, dir, time, batch[static_cast<std::size_t>(i)]);
           }
           tracer.intersectCoherent(batch.data(), static_cast<unsigned>(count));
           for (int i = 0; i < count; ++i) {
@@ -362,7 +411,9 @@ std::uint64_t renderTiles(const FrameData& f, RTCScene scene, const PathTraceSet
             smp.index = static_cast<std::uint32_t>(s0 + i);
             const V3 dir{rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z};
             if (withAovs) aovPixel.add(rh, dir);
-            const V3 c = albedoPass ? surfaceAlbedo(f, rh, dir) : tracer.radiance(rh, dir, smp);
+            const V3 c = !albedoPass          ? tracer.radiance(rh, dir, smp)
+                         : f.motionSteps == 0 ? surfaceAlbedo(f, rh, dir)
+                                              : makeSurface(f, rh, dir, rh.ray.time).albedo;
             if (!isFinite(c)) {
               ++dropped;
               continue;

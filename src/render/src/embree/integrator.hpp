@@ -22,7 +22,8 @@ std::uint64_t renderTiles(const FrameData& f, RTCScene scene, const PathTraceSet
                           std::atomic<int>& next, ImageRGBAF& out, AovImage* aovs);
 
 // The shading point of a camera or bounce ray's hit (ray direction dir,
-// unit): normals flipped to the side the ray came from, that side's albedo.
-Surface makeSurface(const FrameData& f, const RTCRayHit& rh, V3 dir);
+// unit) at shutter time `time` (motion blur; still meshes ignore it):
+// normals flipped to the side the ray came from, that side's albedo.
+Surface makeSurface(const FrameData& f, const RTCRayHit& rh, V3 dir, float time);
 
 }  // namespace crumple::render::pt

@@ -231,8 +231,19 @@ void attach(EmbreeDevice& device, RTCScene scene, MeshData& m, SheetLook* filter
       rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_TRIANGLE), &rtcReleaseGeometry);
   if (!g) device.check("rtcNewGeometry");
   m.vertices.push_back(V3{});  // padding: Embree may read 16 bytes at the last vertex
-  rtcSetSharedGeometryBuffer(g.get(), RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                             m.vertices.data(), 0, sizeof(V3), m.vertices.size() - 1);
+  if (m.steps.empty()) {
+    rtcSetSharedGeometryBuffer(g.get(), RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                               m.vertices.data(), 0, sizeof(V3), m.vertices.size() - 1);
+  } else {
+    // Multi-segment motion blur: one vertex buffer per time step over [0, 1].
+    rtcSetGeometryTimeStepCount(g.get(), static_cast<unsigned>(m.steps.size()));
+    for (std::size_t s = 0; s < m.steps.size(); ++s) {
+      std::vector<V3>& step = m.steps[s];
+      step.push_back(V3{});
+      rtcSetSharedGeometryBuffer(g.get(), RTC_BUFFER_TYPE_VERTEX, static_cast<unsigned>(s),
+                                 RTC_FORMAT_FLOAT3, step.data(), 0, sizeof(V3), step.size() - 1);
+    }
+  }
   rtcSetSharedGeometryBuffer(g.get(), RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                              m.triangles.data(), 0, sizeof(m.triangles[0]), m.triangles.size());
   if (filterLook != nullptr) {
@@ -243,6 +254,37 @@ void attach(EmbreeDevice& device, RTCScene scene, MeshData& m, SheetLook* filter
   rtcCommitGeometry(g.get());
   rtcAttachGeometry(scene, g.get());
   device.check("geometry setup");
+}
+
+// Motion blur: the sheet's and the moving props' vertices, face normals and
+// (the sheet's) shading normals at every time step of the shutter, about
+// the frame's origin (buildStepGeometry). meshOfProp[k]: the index in
+// f.meshes of prop k's mesh, -1 when it has none.
+void addMotionSteps(const RenderScene& scene, const mesh::SheetMesh& sheet,
+                    const detail::RenderGeometry& g, const std::vector<int>& meshOfProp,
+                    FrameData& f) {
+  f.motionSteps = scene.motionSteps();
+  f.cameraPairs = 3;
+  for (std::size_t s = 0; s < f.motionSteps; ++s) {
+    const detail::RenderGeometry gs = detail::buildStepGeometry(scene, sheet, true, g, s);
+    if (!scene.sheetMotion.empty() && !sheet.triangles.empty()) {
+      SheetLook look;
+      MeshData m = sheetMesh(sheet, gs, look);
+      MeshData& data = f.meshes.front();  // the sheet's, first when it has triangles
+      data.steps.push_back(std::move(m.vertices));
+      data.stepFaceNormals.push_back(std::move(m.faceNormals));
+      auto& normals = f.sheet.stepNormals.emplace_back();
+      normals.reserve(look.tris.size());
+      for (const SheetTri& t : look.tris) normals.push_back(t.normals);
+    }
+    for (std::size_t k = 0; k < scene.props.size(); ++k) {
+      if (meshOfProp[k] < 0 || scene.props[k].motion.empty()) continue;
+      MeshData m = propMesh(gs.props[k]);
+      MeshData& data = f.meshes[static_cast<std::size_t>(meshOfProp[k])];
+      data.steps.push_back(std::move(m.vertices));
+      data.stepFaceNormals.push_back(std::move(m.faceNormals));
+    }
+  }
 }
 
 }  // namespace
@@ -295,12 +337,15 @@ FrameData buildFrameData(const RenderScene& scene, const mesh::SheetMesh& sheet,
     f.meshes.push_back(groundMesh(*g.ground, scene.ground.color));
     f.meshes.back().objectId = 2.0f;
   }
+  std::vector<int> propMeshes(g.props.size(), -1);
   for (std::size_t k = 0; k < g.props.size(); ++k)
     if (!g.props[k].mesh->triangles.empty()) {
+      propMeshes[k] = static_cast<int>(f.meshes.size());
       f.meshes.push_back(propMesh(g.props[k]));
       f.meshes.back().objectId = static_cast<float>(3 + k);
     }
   f.origin = g.origin;
+  if (scene.motionSteps() > 0) addMotionSteps(scene, sheet, g, propMeshes, f);
 
   makeLights(g.lights, f);
   const Vec3 env = scene.environment.color * scene.environment.intensity;

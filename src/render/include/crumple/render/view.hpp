@@ -122,6 +122,9 @@ struct PropMesh {
   std::vector<Vec3> vertices;
   std::vector<std::array<int, 3>> triangles;
   Vec3 color{0.6, 0.6, 0.6};  // linear albedo
+  // Motion blur (RenderScene::sheetMotion): its vertices at the shutter's
+  // time steps, each as many as `vertices`; empty: still over the shutter.
+  std::vector<std::vector<Vec3>> motion;
 };
 
 // A diagnostic overlay drawn over the sheet: the structure view of the hybrid
@@ -203,6 +206,18 @@ struct RenderScene {
   mesh::TearAtlas tears;
   // The colour of uncovered pixels (their alpha is 0), linear RGB.
   Vec3 background{0.80, 0.82, 0.86};
+  // Motion blur, the path tracer's (docs/RENDERING.md "Motion blur"): the
+  // sheet's vertex positions at K >= 2 time steps evenly spaced over the
+  // shutter, from its opening to its closing, each as many as the sheet's;
+  // each camera ray has its own time in the shutter, and the surfaces move
+  // linearly between the steps (Embree's multi-segment motion blur). Empty:
+  // the sheet is still (its own positions); with props' motion too, every
+  // non-empty one has the same K. The camera, lights and ground stay put;
+  // the rasteriser draws the sheet's own positions.
+  std::vector<std::vector<Vec3>> sheetMotion;
+
+  // The number of motion-blur time steps: 0 when nothing moves.
+  std::size_t motionSteps() const;
 };
 
 // What a render computes: the lit picture, or the albedo of the first
