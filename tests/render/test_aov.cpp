@@ -66,6 +66,18 @@ mesh::SheetMesh labelledSheet(std::vector<int>& sharp, std::vector<int>& handles
   return m;
 }
 
+// aovScene over labelledSheet with its labels: the singular vertex, the two
+// handles and the model's regions.
+RenderScene labelledScene(bool ground, mesh::SheetMesh& sheet) {
+  std::vector<int> sharp, handles;
+  sheet = labelledSheet(sharp, handles);
+  RenderScene s = aovScene(ground);
+  s.sharpVertices = sharp;
+  s.handleVertices = handles;
+  s.modelledRegions = true;
+  return s;
+}
+
 // The pixel whose centre sees world point p (topCamera: +X right, -Z up).
 std::size_t pixelOf(const Camera& cam, const Vec3& p) {
   const Vec3 local = cam.rotation.normalized().conjugate() * (p - cam.position);
@@ -102,9 +114,8 @@ Rendered renderAovs(const RenderScene& scene, const mesh::SheetMesh& sheet,
 }
 
 TEST(Aov, ChannelsAreNamedAsCompositorsReadThem) {
-  std::vector<int> sharp, handles;
-  RenderScene scene = aovScene(false);
-  const mesh::SheetMesh sheet = labelledSheet(sharp, handles);
+  mesh::SheetMesh sheet;
+  RenderScene scene = labelledScene(false, sheet);
   const Rendered r = renderAovs(scene, sheet);
   std::vector<std::string> names;
   for (const ImageChannel& c : r.aovs.channels) names.push_back(c.name);
@@ -118,11 +129,8 @@ TEST(Aov, ChannelsAreNamedAsCompositorsReadThem) {
 }
 
 TEST(Aov, DepthNormalAndPositionAreTheFirstHitsGeometry) {
-  std::vector<int> sharp, handles;
-  RenderScene scene = aovScene(false);
-  mesh::SheetMesh sheet = labelledSheet(sharp, handles);
-  scene.sharpVertices = sharp;
-  scene.handleVertices = handles;
+  mesh::SheetMesh sheet;
+  RenderScene scene = labelledScene(false, sheet);
   const Rendered r = renderAovs(scene, sheet);
   // A pixel inside the flat half: every sample hits the sheet at Y = kSheetY.
   const Vec3 target(-0.05, kSheetY, 0.03);
@@ -145,19 +153,15 @@ TEST(Aov, DepthNormalAndPositionAreTheFirstHitsGeometry) {
 }
 
 TEST(Aov, RegionsHandlesAndObjectsAreTheSheetsLabels) {
-  std::vector<int> sharp, handles;
-  RenderScene scene = aovScene(true);
-  mesh::SheetMesh sheet = labelledSheet(sharp, handles);
-  scene.sharpVertices = sharp;
-  scene.handleVertices = handles;
-  scene.modelledRegions = true;
+  mesh::SheetMesh sheet;
+  RenderScene scene = labelledScene(true, sheet);
   const Rendered r = renderAovs(scene, sheet);
   const auto region = [&](std::size_t px) {
     return Vec3(at(r.aovs, "region.R", px), at(r.aovs, "region.G", px), at(r.aovs, "region.B", px));
   };
   const std::size_t flat = pixelOf(scene.camera, Vec3(-0.06, kSheetY, 0.05));
   const std::size_t curved = pixelOf(scene.camera, Vec3(0.03, kSheetY, 0.1));
-  const Vec3 sharpAt = sheet.positions[static_cast<std::size_t>(sharp[0])];
+  const Vec3 sharpAt = sheet.positions[static_cast<std::size_t>(scene.sharpVertices[0])];
   const std::size_t singular = pixelOf(scene.camera, sharpAt);
   // Half an edge (0.02 m) away the triangles around it are curved paper again.
   const std::size_t besideSingular = pixelOf(scene.camera, sharpAt + Vec3(0.0, 0.0, 0.016));
@@ -187,9 +191,8 @@ TEST(Aov, RegionsHandlesAndObjectsAreTheSheetsLabels) {
 }
 
 TEST(Aov, AlbedoIsTheAlbedoPassAndTheBeautyIsUnchanged) {
-  std::vector<int> sharp, handles;
-  RenderScene scene = aovScene(true);
-  const mesh::SheetMesh sheet = labelledSheet(sharp, handles);
+  mesh::SheetMesh sheet;
+  RenderScene scene = labelledScene(true, sheet);
   const Rendered withAovs = renderAovs(scene, sheet);
   EmbreeRenderer r;
   PathTraceSettings p;
@@ -207,11 +210,8 @@ TEST(Aov, AlbedoIsTheAlbedoPassAndTheBeautyIsUnchanged) {
 }
 
 TEST(Aov, IdenticalForAnyThreadCount) {
-  std::vector<int> sharp, handles;
-  RenderScene scene = aovScene(true);
-  mesh::SheetMesh sheet = labelledSheet(sharp, handles);
-  scene.sharpVertices = sharp;
-  scene.handleVertices = handles;
+  mesh::SheetMesh sheet;
+  RenderScene scene = labelledScene(true, sheet);
   const int saved = threadCount();
   setThreadCount(1);
   const Rendered one = renderAovs(scene, sheet);
@@ -225,9 +225,8 @@ TEST(Aov, IdenticalForAnyThreadCount) {
 }
 
 TEST(Aov, TheRendererInterfaceCarriesThemAndTheRasteriserRefuses) {
-  std::vector<int> sharp, handles;
-  const RenderScene scene = aovScene(false);
-  const mesh::SheetMesh sheet = labelledSheet(sharp, handles);
+  mesh::SheetMesh sheet;
+  const RenderScene scene = labelledScene(false, sheet);
   FrameSettings settings;
   settings.aovs = {Aov::Depth, Aov::ObjectId};
   RendererOptions options;
