@@ -107,19 +107,6 @@ Surface makeSurface(const FrameData& f, const RTCRayHit& rh, V3 dir, float time)
 
 namespace {
 
-// The first hit's albedo only (the albedo pass).
-V3 surfaceAlbedo(const FrameData& f, const RTCRayHit& rh, V3 dir) {
-  const MeshData& m = f.meshes[rh.hit.geomID];
-  if (m.kind != GeomKind::Sheet) return m.color;
-  const unsigned prim = rh.hit.primID;
-  V3 ng = m.faceNormals[prim];
-  if (isBlack(ng)) ng = V3{rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
-  const Vec4 tex = sampleTexture(*f.sheet.texture, sheetUv(f.sheet.tris[prim], rh.hit.u, rh.hit.v));
-  const V3 texel{static_cast<float>(tex.x()), static_cast<float>(tex.y()),
-                 static_cast<float>(tex.z())};
-  return texel * (dot(dir, ng) < 0.0f ? f.sheet.front : f.sheet.back);
-}
-
 // BSDF times cosine for the unit direction wi; pdf receives the BSDF
 // sampling density of wi (the scalar factor: f cos = albedo * pdf).
 inline V3 evalBsdf(const Surface& s, V3 wi, float& pdf) {
@@ -411,9 +398,8 @@ std::uint64_t renderTiles(const FrameData& f, RTCScene scene, const PathTraceSet
             smp.index = static_cast<std::uint32_t>(s0 + i);
             const V3 dir{rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z};
             if (withAovs) aovPixel.add(rh, dir);
-            const V3 c = !albedoPass          ? tracer.radiance(rh, dir, smp)
-                         : f.motionSteps == 0 ? surfaceAlbedo(f, rh, dir)
-                                              : makeSurface(f, rh, dir, rh.ray.time).albedo;
+            const V3 c = albedoPass ? makeSurface(f, rh, dir, rh.ray.time).albedo
+                                    : tracer.radiance(rh, dir, smp);
             if (!isFinite(c)) {
               ++dropped;
               continue;
