@@ -107,8 +107,7 @@ float AovPixel::majority(const std::vector<std::pair<float, int>>& counts) {
   return id;
 }
 
-void AovPixel::add(const RTCRayHit& rh, V3 dir) {
-  const Surface s = makeSurface(f_, rh, dir, rh.ray.time);
+void AovPixel::add(const RTCRayHit& rh, const Surface& s) {
   const MeshData& m = f_.meshes[rh.hit.geomID];
   ++hits_;
   nearest_ = std::min(nearest_, dot(s.p - f_.camera.pos, f_.camera.forward));

@@ -44,8 +44,8 @@ class AovPixel {
   explicit AovPixel(const FrameData& f) : f_(f) {}
 
   void reset();
-  // A camera ray along the unit direction `dir` that hit rh.
-  void add(const RTCRayHit& rh, V3 dir);
+  // A camera ray that hit rh, at shading point s (makeSurface).
+  void add(const RTCRayHit& rh, const Surface& s);
   // The pixel's values over `spp` camera rays into out's channels (in
   // makeAovImage's order for `aovs`).
   void store(const std::vector<Aov>& aovs, std::size_t pixel, int spp, AovImage& out) const;

@@ -205,12 +205,12 @@ class Tracer {
     return r.tfar >= 0.0f;
   }
 
-  // Radiance arriving along a camera ray that hit `first` (premultiplied
-  // path contribution; may be non-finite, the caller checks).
-  V3 radiance(const RTCRayHit& first, V3 dir, const PixelSampler& smp) {
-    const float time = first.ray.time;  // the camera ray's: the whole path's
+  // Radiance arriving along a camera ray whose first hit's shading point is
+  // `first`, at the ray's shutter time (the whole path's): premultiplied path
+  // contribution; may be non-finite, the caller checks.
+  V3 radiance(const Surface& first, float time, const PixelSampler& smp) {
     V3 result{}, beta{1.0f, 1.0f, 1.0f};
-    Surface s = makeSurface(f_, first, dir, time);
+    Surface s = first;
     const bool needEmissionRay =
         f_.hasEnvironment || !f_.sunLights.empty() || !f_.areaLights.empty();
     for (int k = 0;; ++k) {
@@ -397,9 +397,10 @@ std::uint64_t renderTiles(const FrameData& f, RTCScene scene, const PathTraceSet
             ++hits;
             smp.index = static_cast<std::uint32_t>(s0 + i);
             const V3 dir{rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z};
-            if (withAovs) aovPixel.add(rh, dir);
-            const V3 c = albedoPass ? makeSurface(f, rh, dir, rh.ray.time).albedo
-                                    : tracer.radiance(rh, dir, smp);
+            // The first hit's shading point, once for the AOVs and the path.
+            const Surface first = makeSurface(f, rh, dir, rh.ray.time);
+            if (withAovs) aovPixel.add(rh, first);
+            const V3 c = albedoPass ? first.albedo : tracer.radiance(first, rh.ray.time, smp);
             if (!isFinite(c)) {
               ++dropped;
               continue;
