@@ -16,7 +16,7 @@ cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$BUILD_DIR" --target crumple golden_tool test_golden test_render
 
 # sample:frame (the frame shown in the golden image)
-FRAMES="backlit-cutout:40 crumple:108 cylinder-fold:102 drape:48 first-singularity:96 moebius:80 unload:102"
+FRAMES="backlit-cutout:40 crumple:108 cylinder-fold:70 drape:48 first-singularity:96 moebius:80 unload:102"
 if [ "${1:-}" = "--inputs" ]; then
   tmp=$(mktemp -d)
   trap 'rm -rf "$tmp"' EXIT

@@ -26,7 +26,8 @@ struct Args {
   std::string pass = "beauty";
   bool exr = false;
   bool noPng = false;
-  std::string aovs;  // --aov: a comma-separated list (render/aov.hpp)
+  std::string aovs;    // --aov: a comma-separated list (render/aov.hpp)
+  std::string refine;  // --refine: auto, off or N (pipeline/refine.hpp); empty: the default
   bool contactSheet = false;
   bool movie = false;
   bool json = false;

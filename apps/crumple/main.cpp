@@ -175,6 +175,11 @@ void addCacheCommands(CLI::App& app, Args& a, Commands& c) {
       "output folder (default: export/<format>/ beside the cache); locked while "
       "writing (exit 2 when another crumple writes there), shared by exports "
       "of a --frames range");
+  c.exportCmd->add_option(
+      "--refine", a.refine,
+      "the crumpling model's curved regions written finer along their rulings, isometric to "
+      "the pattern: auto (folds of at most 1.8 degrees between sub-cells; default), off (the "
+      "simulated mesh) or N sub-cells per face; docs/EXPORT.md");
   c.exportCmd->add_option("--frames", a.frames,
                           "A-B: frames to export (default: every cached frame)");
 }

@@ -16,6 +16,7 @@
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/output_lock.hpp"
+#include "crumple/pipeline/refine.hpp"
 
 namespace crumple::pipeline {
 namespace {
@@ -142,7 +143,8 @@ ExportReport exportCache(const std::string& cachePath, const ExportOptions& opti
   bool sharedMtl = false;  // paper.mtl written
   const auto written = [&](const fs::path& p) { report.files.push_back(p.string()); };
   for (std::size_t k = 0; k < indices.size(); ++k) {
-    const cache::FrameRecord frame = reader.readFrame(indices[k]);
+    cache::FrameRecord frame = reader.readFrame(indices[k]);
+    if (refineFrame(frame, options.refine)) ++report.refinedFrames;
     const exporters::ExportMesh mesh = exporters::exportMesh(frame, header.fps, uv);
     const std::string stem = exporters::frameStem(frame.frame);
     switch (format) {

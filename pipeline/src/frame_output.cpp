@@ -52,6 +52,19 @@ render::StructureOverlay structureOverlay(const cache::FrameRecord& frame) {
 
 }  // namespace
 
+// What the frames are refined with: as asked, else auto for the path
+// tracer; never under the structure view (its colours are per S_P triangle).
+mesh::RefineOptions refinement(const RenderSettings& settings, bool debugStructure) {
+  if (debugStructure) {
+    if (settings.refine && settings.refine->mode != mesh::RefineMode::Off)
+      throw InputError("--refine", "the structure view shows the simulated mesh: use --refine off");
+    return FrameViewBuilder::offRefinement();
+  }
+  if (settings.refine) return *settings.refine;
+  return settings.backend == RenderSettings::Backend::Embree ? mesh::RefineOptions{}
+                                                             : FrameViewBuilder::offRefinement();
+}
+
 struct FrameRenderer::Impl {
   std::string framesDir;
   bool debugStructure = false;
@@ -61,7 +74,10 @@ struct FrameRenderer::Impl {
 
   Impl(const io::SceneSpec& scene, const std::vector<cache::ExtensionBlock>& headerBlocks,
        std::string dir, bool debug, const RenderSettings& r, std::uint64_t seed)
-      : framesDir(std::move(dir)), debugStructure(debug), settings(r), views(scene, headerBlocks) {
+      : framesDir(std::move(dir)),
+        debugStructure(debug),
+        settings(r),
+        views(scene, headerBlocks, refinement(r, debug)) {
     const bool embree = settings.backend == RenderSettings::Backend::Embree;
     if (embree && debugStructure)
       throw InputError("--debug-structure",

@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "crumple/cache/pcache_contacts.hpp"
+#include "crumple/cache/pcache_developable.hpp"
 #include "crumple/cache/pcache_sound.hpp"
 #include "crumple/core/error.hpp"
 #include "crumple/pipeline/inspect.hpp"
@@ -81,6 +82,13 @@ void ShotRunner::recordSheet(int frame) {
   record_.junctionVertices = std::move(structure.junctionVertices);
   record_.rulings.clear();
   for (const auto& r : structure.rulings) record_.rulings.push_back({r[0], r[1]});
+  std::optional<cache::ExtensionBlock> developable;
+  if (sheet.crumpling()) {
+    std::vector<cache::RegionRulings> regions;
+    for (const auto& r : structure.regions)
+      regions.push_back({r.region, r.apex, static_cast<std::uint32_t>(r.count)});
+    developable = cache::encodeRegionRulings(regions);
+  }
   report_.maxTriangles = std::max(report_.maxTriangles, mesh.triangleCount());
   if (const auto counts = sheet.singularCounts()) {
     report_.singularVertices = counts->first;
@@ -108,6 +116,7 @@ void ShotRunner::recordSheet(int frame) {
     record_.extensions.push_back(std::move(*motions));
   if (tearAtlasBlock_) record_.extensions.push_back(*tearAtlasBlock_);
   if (structureBlock_) record_.extensions.push_back(*structureBlock_);
+  if (developable) record_.extensions.push_back(std::move(*developable));
   record_.tearCount =
       tearStage_ ? static_cast<std::uint32_t>(tearStage_->tearing().startKinds().size()) : 0;
 }

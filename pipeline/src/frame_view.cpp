@@ -1,16 +1,19 @@
 // What the renderers draw for a cached frame (shot.hpp: FrameViewBuilder),
 // and the look data a cache carries so that rendering needs nothing else
 // (docs/PCACHE.md "Extension sub-blocks written by crumple").
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iterator>
 #include <limits>
 
+#include "crumple/cache/pcache_developable.hpp"
 #include "crumple/cache/pcache_look.hpp"
 #include "crumple/cache/pcache_tear.hpp"
 #include "crumple/core/error.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/pipeline/inspect.hpp"
+#include "crumple/pipeline/refine.hpp"
 #include "crumple/pipeline/shot.hpp"
 
 namespace crumple::pipeline {
@@ -145,9 +148,24 @@ std::optional<cache::ExtensionBlock> propMotionBlock(const io::SceneSpec& scene,
   return cache::encodePropMotions(motions);
 }
 
+namespace {
+
+// The pixel size along the camera's view axis (mesh::ScreenMetric).
+mesh::ScreenMetric screenMetric(const render::Camera& camera) {
+  mesh::ScreenMetric m;
+  m.eye = camera.position;
+  m.forward = camera.rotation * Vec3(0.0, 0.0, -1.0);
+  m.pixelAngle = 2.0 * std::tan(0.5 * camera.yfov) / camera.height;
+  m.znear = camera.znear;
+  return m;
+}
+
+}  // namespace
+
 FrameViewBuilder::FrameViewBuilder(const io::SceneSpec& scene,
-                                   const std::vector<cache::ExtensionBlock>& headerBlocks)
-    : scene_(scene) {
+                                   const std::vector<cache::ExtensionBlock>& headerBlocks,
+                                   const mesh::RefineOptions& refine)
+    : scene_(scene), refine_(refine) {
   if (const auto* png = cache::findPaperTexture(headerBlocks))
     texture_ = exporters::decodePngBytes(*png, "the cache's paper texture");
   else
@@ -172,9 +190,21 @@ FrameViewBuilder::FrameViewBuilder(const io::SceneSpec& scene,
   }
 }
 
-FrameView FrameViewBuilder::build(const cache::FrameRecord& frame) const {
+FrameView FrameViewBuilder::build(const cache::FrameRecord& source) const {
   FrameView fv;
-  fv.scene = makeRenderScene(scene_, frame.camera);
+  fv.scene = makeRenderScene(scene_, source.camera);
+  // The crumpling model's curved regions refined (refine.hpp), Auto on this
+  // frame's camera.
+  std::optional<cache::FrameRecord> refinedFrame;
+  const bool developable = std::ranges::any_of(
+      source.extensions, [](const auto& b) { return b.tag == cache::kDevelopableTag; });
+  if (refine_.mode != mesh::RefineMode::Off && developable) {
+    refinedFrame = source;
+    mesh::RefineOptions o = refine_;
+    if (o.mode == mesh::RefineMode::Auto && !o.screen) o.screen = screenMetric(fv.scene.camera);
+    fv.refined = refineFrame(*refinedFrame, o);
+  }
+  const cache::FrameRecord& frame = refinedFrame ? *refinedFrame : source;
   fv.scene.paper.texture = texture_;
   if (scene_.look.textureSize.x() > 0.0) {
     fv.scene.paper.textureSize = scene_.look.textureSize;

@@ -1,5 +1,5 @@
 // libFuzzer target: the cache reader, cache::CacheReader, and the decoders of
-// the sub-blocks crumple writes (TEAR, COLL/CONT, SNDS/SEVT; docs/PCACHE.md).
+// the sub-blocks crumple writes (TEAR, COLL/CONT, SNDS/SEVT, SGEO; docs/PCACHE.md).
 // Any input must either read or throw crumple::InputError (open) or
 // crumple::CorruptDataError (a damaged frame or sub-block); everything else
 // is a bug. Each input is read twice: as given, and with every chunk's CRC
@@ -12,6 +12,7 @@
 
 #include "crumple/cache/pcache.hpp"
 #include "crumple/cache/pcache_contacts.hpp"
+#include "crumple/cache/pcache_developable.hpp"
 #include "crumple/cache/pcache_sound.hpp"
 #include "crumple/cache/pcache_tear.hpp"
 #include "crumple/core/crc32.hpp"
@@ -36,6 +37,7 @@ void readEverything(const crumple::cache::CacheReader& reader) {
       tolerateDamage([&] { return cache::decodeTearAtlas(frame.extensions); });
       tolerateDamage([&] { return cache::decodeContacts(frame.extensions); });
       tolerateDamage([&] { return cache::decodeSoundEvents(frame.extensions); });
+      tolerateDamage([&] { return cache::decodeDevelopable(frame); });
       return 0;
     });
   }

@@ -20,6 +20,7 @@
 
 #include "crumple/cache/pcache.hpp"
 #include "crumple/cache/pcache_contacts.hpp"
+#include "crumple/cache/pcache_developable.hpp"
 #include "crumple/cache/pcache_sound.hpp"
 #include "crumple/cache/pcache_tear.hpp"
 #include "crumple/core/error.hpp"
@@ -189,7 +190,7 @@ TEST(FuzzSeeds, BinaryGltfWithImpossibleLengthsIsRejectedBeforeAssimp) {
 }
 
 // A tiny cache carrying every sub-block crumple writes (COLL and SNDS in the
-// header; CONT, TEAR and SEVT in a frame) reads back equal through the
+// header; CONT, TEAR, SEVT and SGEO in a frame) reads back equal through the
 // decoders and passes through the cache target. corpus/cache/blocks.pcache is
 // this file (CRUMPLE_FUZZ_SEED_OUT=path writes a copy there).
 TEST(FuzzSeeds, CacheWithEverySubBlockReadsBack) {
@@ -213,8 +214,9 @@ TEST(FuzzSeeds, CacheWithEverySubBlockReadsBack) {
   frame.frame = 1;
   frame.time = 1.0 / 24.0;
   frame.triangles = {{0, 1, 2}, {0, 2, 3}};
-  frame.regionOfTriangle = {0, 0};
-  frame.regionTypes = {0};
+  frame.regionOfTriangle = {0, 1};
+  frame.regionTypes = {0, 1};
+  frame.rulings = {{0, 2}, {0, 3}};
   frame.pattern = {Vec2(0, 0), Vec2(0.1, 0), Vec2(0.1, 0.1), Vec2(0, 0.1)};
   frame.positions = {Vec3(0, 0, 0), Vec3(0.1, 0, 0), Vec3(0.1, 0, -0.1), Vec3(0, 0, -0.1)};
   frame.handleVertices = {0};
@@ -237,7 +239,7 @@ TEST(FuzzSeeds, CacheWithEverySubBlockReadsBack) {
   event.position = Vec3(0.05, 0, -0.05);
   event.resonators = {{0.05, 0.02, 1e-3, Vec3(0.05, 0, -0.05), Vec3::UnitY(), 0.02}};
   frame.extensions = {cache::encodeContacts(contacts), cache::encodeTearAtlas(atlas),
-                      cache::encodeSoundEvents({event})};
+                      cache::encodeSoundEvents({event}), cache::encodeRegionRulings({{1, 0, 2}})};
   {
     cache::CacheWriter writer(path.string(), header);
     writer.append(frame);
@@ -257,6 +259,10 @@ TEST(FuzzSeeds, CacheWithEverySubBlockReadsBack) {
     EXPECT_EQ(cache::decodeTearAtlas(first.extensions), atlas);
     ASSERT_TRUE(cache::decodeSoundEvents(first.extensions).has_value());
     EXPECT_EQ(cache::decodeSoundEvents(first.extensions)->size(), 1u);
+    const auto developable = cache::decodeDevelopable(first);
+    ASSERT_TRUE(developable.has_value());
+    ASSERT_EQ(developable->regions.size(), 1u);
+    EXPECT_EQ(developable->regions[0].apex, 0);
   }
   const std::vector<std::uint8_t> bytes = readBytes(path);
   EXPECT_EQ(crumpleFuzz_cache(bytes.data(), bytes.size()), 0);

@@ -167,8 +167,13 @@ SheetStructure CrumplingModel::structure() const {
   SheetStructure s;
   s.singularVertices = singularVertices();
   s.junctionVertices = paper::junctionVertices(sheet_->geometric());
-  for (const auto& region : sheet_->geometric().regions)
-    for (const auto& r : region.rulings) s.rulings.push_back({r.a, r.b});
+  const auto& regions = sheet_->geometric().regions;
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    if (regions[i].rulings.empty()) continue;
+    s.regions.push_back(
+        {static_cast<int>(i), regions[i].apex, static_cast<int>(regions[i].rulings.size())});
+    for (const auto& r : regions[i].rulings) s.rulings.push_back({r.a, r.b});
+  }
   return s;
 }
 

@@ -21,7 +21,7 @@ class ElasticModel final : public SheetModel {
   bool crumpling() const override { return false; }
   FrameStats advance(int frame, const sim::PinFunction& pins) override;
   const mesh::SheetMesh& mesh() const override { return mesh_; }
-  SheetStructure structure() const override { return {singular_, {}, {}}; }
+  SheetStructure structure() const override { return {singular_, {}, {}, {}}; }
   std::optional<std::pair<int, int>> singularCounts() const override { return std::nullopt; }
   const std::vector<sim::ContactSample>& contacts() const override;
   const sim::ElasticSheet& elastic() const override { return sheet_; }

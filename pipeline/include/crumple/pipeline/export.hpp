@@ -20,6 +20,7 @@ struct ExportOptions {
   ExportFormat format = ExportFormat::Obj;
   std::string outDir;                // empty: <cache folder>/export/<format>
   std::optional<FrameRange> frames;  // default: every cached frame
+  mesh::RefineOptions refine;        // the crumpling model's curved regions (refine.hpp): auto
   std::FILE* log = stderr;           // progress; nullptr: a quiet run
   int interactive = -1;              // -1: detect a terminal on `log`
 };
@@ -28,6 +29,7 @@ struct ExportReport {
   std::string outDir;
   int frames = 0;                  // frames exported
   int tornFrames = 0;              // of which with a tear texture (OBJ)
+  int refinedFrames = 0;           // of which with curved regions refined
   int topologies = 0;              // USDA: topology time samples (where it changed)
   std::vector<std::string> files;  // every file written, in order
   std::vector<std::string> notes;  // e.g. a cache recovered without its footer

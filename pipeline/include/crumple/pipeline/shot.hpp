@@ -14,6 +14,7 @@
 #include "crumple/cache/pcache.hpp"
 #include "crumple/io/animation.hpp"
 #include "crumple/io/scene.hpp"
+#include "crumple/mesh/developable.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/render/aov.hpp"
 #include "crumple/render/view.hpp"
@@ -44,6 +45,9 @@ struct RenderSettings {
   // Embree: AOV channels in NNNN.exr beside RGBA (render/aov.hpp); not
   // empty writes the EXR whatever `exr` says.
   std::vector<render::Aov> aovs;
+  // The crumpling model's curved regions refined (refine.hpp); nullopt: auto
+  // for embree, off for osmesa. Off under the structure view.
+  std::optional<mesh::RefineOptions> refine;
   bool contactSheet = false;  // contact_sheet.png in the shot's folder (beside the cache)
   bool movie = false;         // preview.mp4 there through ffmpeg, with its sound.wav if any
 };
@@ -237,18 +241,31 @@ render::RenderScene makeRenderScene(const io::SceneSpec& scene, const cache::Cam
 // from the frame's block, propMotionBlock): rendering needs nothing but the
 // cache. Keeps a reference to `scene`. Throws CorruptDataError on malformed
 // blocks, InputError on a texture that is not a PNG.
+//
+// With refinement on (`refine`, mesh/developable.hpp), a frame of the
+// crumpling model (its SGEO block) gets its curved regions refined: Auto
+// measures the density on the frame's camera; the tear patches follow their
+// triangles.
 struct FrameView {
   render::RenderScene scene;
   mesh::SheetMesh sheet;
+  std::optional<mesh::RefineStats> refined;  // the refinement's figures, when it ran
 };
 class FrameViewBuilder {
  public:
   FrameViewBuilder(const io::SceneSpec& scene,
-                   const std::vector<cache::ExtensionBlock>& headerBlocks);
+                   const std::vector<cache::ExtensionBlock>& headerBlocks,
+                   const mesh::RefineOptions& refine = offRefinement());
   FrameView build(const cache::FrameRecord& frame) const;
+  static mesh::RefineOptions offRefinement() {
+    mesh::RefineOptions o;
+    o.mode = mesh::RefineMode::Off;
+    return o;
+  }
 
  private:
   const io::SceneSpec& scene_;
+  mesh::RefineOptions refine_;
   ImageRGBA8 texture_;
   std::vector<render::PropMesh> boxes_;
   std::vector<render::PropMesh> meshPropsAtRest_;

@@ -79,6 +79,14 @@ struct SheetStructure {
   std::vector<int> singularVertices;
   std::vector<int> junctionVertices;
   std::vector<std::array<int, 2>> rulings;
+  // Which rulings are whose: region by region, in `rulings`' order, every
+  // region with rulings (paper Sec. 3.2, R_C), with its apex (-1: none).
+  struct RegionRulings {
+    int region = -1;
+    int apex = -1;
+    int count = 0;
+  };
+  std::vector<RegionRulings> regions;
 };
 
 // A frame's tearing as a model takes it (thesis 3.3): the tear stage found
