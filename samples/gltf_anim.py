@@ -225,6 +225,22 @@ def write_sample(script, default_name, times, tracks, camera=None, generator=Non
     return path
 
 
+def write_sample_of(script, source, default_name):
+    """write_sample for a sample that runs another sample's motion exactly:
+    the tracks() of the generator `source` (a path relative to `script`'s
+    folder), written next to `script`; the generator string names both
+    scripts."""
+    import importlib.util
+    here = os.path.dirname(os.path.abspath(script))
+    source = os.path.join(here, source)
+    name = os.path.splitext(os.path.basename(source))[0]
+    spec = importlib.util.spec_from_file_location(name, source)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return write_sample(script, default_name, *module.tracks(),
+                        generator="crumple %s (%s)" % (sample_path(script), sample_path(source)))
+
+
 # ---- static meshes ----
 def uv_sphere(radius, segments=(48, 24)):
     """Positions, normals and counter-clockwise (seen from outside) triangle

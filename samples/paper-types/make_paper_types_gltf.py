@@ -14,24 +14,17 @@ folder (eps-1.0.toml, eps-0.5.toml, eps-0.2.toml) share this file.
 Run it to regenerate the file (the committed file is its output):
     python3 samples/paper-types/make_paper_types_gltf.py [OUT.gltf]
 """
-import importlib.util
 import os
 import sys
 
 # Shared helpers (samples/gltf_anim.py).
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, ".."))
-from gltf_anim import sample_path, write_sample  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from gltf_anim import write_sample_of  # noqa: E402
 
 
 def main():
-    source = os.path.join(HERE, "..", "cylinder-fold", "make_cylinder_fold_gltf.py")
-    spec = importlib.util.spec_from_file_location("make_cylinder_fold_gltf", source)
-    cylinder_fold = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(cylinder_fold)
-    # The generator names both scripts.
-    write_sample(__file__, "cylinder-fold.gltf", *cylinder_fold.tracks(),
-                 generator="crumple %s (%s)" % (sample_path(__file__), sample_path(source)))
+    write_sample_of(__file__, os.path.join("..", "cylinder-fold", "make_cylinder_fold_gltf.py"),
+                    "cylinder-fold.gltf")
 
 
 if __name__ == "__main__":
