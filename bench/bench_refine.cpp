@@ -14,6 +14,8 @@
 //   refinement, --runs times each, interleaved; the median wall times of the
 //   whole frame (the view built from the cache, refinement included, then a
 //   fresh renderer's render()) and their ratio.
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -109,6 +111,15 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+// CPU time of this process so far (user + system, every thread), ms: far
+// less disturbed than wall time by other processes on a shared machine.
+double cpuMs() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return 1e3 * (u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-3 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
 double msSince(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
@@ -186,10 +197,11 @@ int run(const Options& o) {
     ro.width = o.width;
     ro.height = o.height;
     ro.samplesPerPixel = o.spp;
-    std::vector<double> plainMs, refinedMs, refineOnlyMs;
+    std::vector<double> plainMs, refinedMs, refineOnlyMs, plainCpu, refinedCpu;
     for (int r = 0; r < o.runs; ++r) {
       for (const pipeline::FrameViewBuilder* builder : {&plain, &refined}) {
         const auto t0 = Clock::now();
+        const double cpu0 = cpuMs();
         const pipeline::FrameView fv = builder->build(record);
         const double buildMs = msSince(t0);
         const auto renderer = render::makeRenderer(render::Backend::Embree, ro);
@@ -197,19 +209,21 @@ int run(const Options& o) {
         settings.frame = f;
         (void)renderer->render(fv.scene, fv.sheet, settings, render::RenderPass::Beauty);
         (builder == &plain ? plainMs : refinedMs).push_back(msSince(t0));
+        (builder == &plain ? plainCpu : refinedCpu).push_back(cpuMs() - cpu0);
         if (builder == &refined) refineOnlyMs.push_back(buildMs);
       }
     }
     const double p = median(plainMs), q = median(refinedMs);
+    const double pc = median(plainCpu), qc = median(refinedCpu);
     std::printf(
-        "frame %d at %d spp: %.0f ms plain, %.0f ms refined (of which building the view "
-        "%.1f ms): x%.3f (%d runs, medians)\n",
-        f, o.spp, p, q, median(refineOnlyMs), q / p, o.runs);
-    char row[200];
-    std::snprintf(
-        row, sizeof row,
-        "%s{\"frame\":%d,\"spp\":%d,\"plain_ms\":%.3f,\"refined_ms\":%.3f,\"ratio\":%.4f}",
-        renders.empty() ? "" : ",", f, o.spp, p, q, q / p);
+        "frame %d at %d spp: %.0f ms plain, %.0f ms refined (of which building the view %.1f "
+        "ms): x%.3f wall, x%.3f CPU (%.0f / %.0f ms) (%d runs, medians)\n",
+        f, o.spp, p, q, median(refineOnlyMs), q / p, qc / pc, pc, qc, o.runs);
+    char row[240];
+    std::snprintf(row, sizeof row,
+                  "%s{\"frame\":%d,\"spp\":%d,\"plain_ms\":%.3f,\"refined_ms\":%.3f,"
+                  "\"ratio\":%.4f,\"cpu_ratio\":%.4f}",
+                  renders.empty() ? "" : ",", f, o.spp, p, q, q / p, qc / pc);
     renders += row;
   }
   if (!o.json.empty()) {
