@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "crumple/cache/pcache.hpp"
+#include "crumple/cache/pcache_motion.hpp"
 #include "crumple/io/animation.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/mesh/sheet_mesh.hpp"
@@ -44,6 +45,10 @@ struct RenderSettings {
   // Embree: AOV channels in NNNN.exr beside RGBA (render/aov.hpp); not
   // empty writes the EXR whatever `exr` says.
   std::vector<render::Aov> aovs;
+  // Embree: the motion blur's shutter (`render --shutter`); nullopt: the
+  // one the cache was simulated for (FrameViewBuilder). An open shutter
+  // needs a cache with sub-frame motion (InputError otherwise).
+  std::optional<cache::Shutter> shutter;
   bool contactSheet = false;  // contact_sheet.png in the shot's folder (beside the cache)
   bool movie = false;         // preview.mp4 there through ffmpeg, with its sound.wav if any
 };
@@ -237,6 +242,12 @@ render::RenderScene makeRenderScene(const io::SceneSpec& scene, const cache::Cam
 // from the frame's block, propMotionBlock): rendering needs nothing but the
 // cache. Keeps a reference to `scene`. Throws CorruptDataError on malformed
 // blocks, InputError on a texture that is not a PNG.
+//
+// Motion blur (docs/RENDERING.md "Motion blur"): with a shutter, the view's
+// sheetMotion and its moving mesh props' motion hold their positions at the
+// shutter's opening and closing, from the frame's velocities (VELO, PRPV).
+// The shutter is the one the cache was simulated for (its header's SHTR;
+// none without); setShutter replaces it (closed: every frame sharp).
 struct FrameView {
   render::RenderScene scene;
   mesh::SheetMesh sheet;
@@ -246,12 +257,15 @@ class FrameViewBuilder {
   FrameViewBuilder(const io::SceneSpec& scene,
                    const std::vector<cache::ExtensionBlock>& headerBlocks);
   FrameView build(const cache::FrameRecord& frame) const;
+  void setShutter(const cache::Shutter& shutter) { shutter_ = shutter; }
+  const cache::Shutter& shutter() const { return shutter_; }
 
  private:
   const io::SceneSpec& scene_;
   ImageRGBA8 texture_;
   std::vector<render::PropMesh> boxes_;
   std::vector<render::PropMesh> meshPropsAtRest_;
+  cache::Shutter shutter_;
 };
 
 // The cache header's look blocks (docs/PCACHE.md): "PTEX", the [paper]
