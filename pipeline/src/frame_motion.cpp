@@ -68,15 +68,14 @@ std::vector<Vec3> FrameVelocities::of(const cache::FrameRecord& frame, double fr
 
 namespace {
 
-// The time derivative of a mesh prop's motion M(t) = W(t) W(0)^-1 (W: the
-// node's world matrix) by central differences a thousandth of a frame
-// apart: the instantaneous motion, as the sheet's velocities are.
+// The rate of a mesh prop's motion M(t) = W(t) W(0)^-1 (W: the node's
+// world matrix) over the frame ending at t, (M(t) - M(t - dt)) / dt: its
+// vertices' mean velocities over the frame, as the sheet's are.
 Mat4 motionDerivative(const io::AnimationScene& animation, const std::string& node, double t,
-                      double fps) {
-  const double h = 1e-3 / fps;
+                      double frameDuration) {
   const Mat4 rest = animation.worldMatrix(node, 0.0).inverse();
-  return (animation.worldMatrix(node, t + h) - animation.worldMatrix(node, t - h)) * rest /
-         (2.0 * h);
+  return (animation.worldMatrix(node, t) - animation.worldMatrix(node, t - frameDuration)) * rest /
+         frameDuration;
 }
 
 }  // namespace
@@ -97,7 +96,8 @@ void appendMotionBlocks(const io::SceneSpec& scene, const io::AnimationScene* an
   if (animation == nullptr) return;
   std::vector<Mat4> derivatives;
   for (const auto& p : scene.props)
-    if (!p.node.empty()) derivatives.push_back(motionDerivative(*animation, p.node, t, scene.fps));
+    if (!p.node.empty())
+      derivatives.push_back(motionDerivative(*animation, p.node, t, 1.0 / scene.fps));
   if (!derivatives.empty()) blocks.push_back(cache::encodePropVelocities(derivatives));
 }
 

@@ -51,7 +51,8 @@ class FrameVelocities {
 
 // A frame's sub-frame motion for a scene with a shutter: VELO (the sheet's
 // velocities, one per vertex of the frame's mesh) and, with mesh props,
-// PRPV (each prop's motion's time derivative at t, from the animation).
+// PRPV (each prop's motion's rate over the frame ending at t, from the
+// animation: (M(t) - M(t - 1 / fps)) fps, as the sheet's velocities).
 // Throws NumericalError (stage "cache") unless there is one velocity per
 // vertex, each finite and within cache::kMaxSpeed.
 void appendMotionBlocks(const io::SceneSpec& scene, const io::AnimationScene* animation, int frame,

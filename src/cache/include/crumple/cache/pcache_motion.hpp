@@ -2,8 +2,8 @@
 // Sub-frame motion for motion blur (docs/PCACHE.md "Extension sub-blocks
 // written by crumple", docs/RENDERING.md "Motion blur"): the shutter a shot
 // was simulated for (header "SHTR"), and in every frame of such a shot the
-// sheet's vertex velocities (frame "VELO") and the time derivatives of the
-// mesh props' motions (frame "PRPV"). A renderer moves every vertex
+// sheet's vertex velocities (frame "VELO") and the rates of the mesh
+// props' motions (frame "PRPV"). A renderer moves every vertex
 // linearly with its velocity over the shutter, x + v t: nothing from
 // another frame is needed (its mesh may differ, and `crumple run` renders a
 // frame before the next is simulated). A shot without a shutter writes none
@@ -52,8 +52,8 @@ ExtensionBlock encodeVelocities(const std::vector<Vec3>& velocities);
 // count is checked against the frame's vertices by cache::validate.
 std::optional<std::vector<Vec3>> decodeVelocities(const std::vector<ExtensionBlock>& frameBlocks);
 
-// "PRPV": u32 n; per mesh prop (the order of PRPM), 16 f64: the time
-// derivative of its column-major 4x4 motion at the frame (1/s), so that
+// "PRPV": u32 n; per mesh prop (the order of PRPM), 16 f64: the rate of
+// change of its column-major 4x4 motion at the frame (1/s), so that
 // the prop's vertex x of its rest mesh is at (M + t dM/dt) x a time t (s)
 // after the frame. std::invalid_argument for a value that is not finite.
 ExtensionBlock encodePropVelocities(const std::vector<Mat4>& derivatives);
