@@ -8,12 +8,16 @@
 //   bench_render CACHE --frame F --spp N[,N...] [--ref-spp 1024] [--threads 2]
 //                [--runs 3] [--out DIR] [--blender blender] [--script PATH]
 //                [--max-bounces 4] [--seed 1] [--resolution WxH]
-//                [--aperture R --focus D]
+//                [--aperture R --focus D] [--shutter OPEN,CLOSE]
 //
 // --resolution overrides the scene's image size (same vertical field of
 // view), --aperture / --focus the camera's lens radius and focus distance (m;
 // thin-lens depth of field); --spp takes a list, rendered against the same
-// references.
+// references. Motion blur: a cache simulated with a shutter renders blurred
+// (its own shutter, or --shutter's; 0 draws it sharp), and Cycles gets the
+// same motion: the sheet's (and moving props') positions at the shutter's
+// steps as shape keys keyed linearly over Blender's centred shutter of the
+// same length (render_cycles.py), Cycles' deformation motion blur.
 //
 // - Time: median wall time of --runs renders at each N (interleaved, ours
 //   then Cycles, so both see the same machine load). Ours: a fresh
@@ -64,6 +68,7 @@
 #include <vector>
 
 #include "crumple/cache/pcache.hpp"
+#include "crumple/cache/pcache_motion.hpp"
 #include "crumple/core/error.hpp"
 #include "crumple/core/exit_status.hpp"
 #include "crumple/core/parallel.hpp"
@@ -108,12 +113,14 @@ struct Options {
   int width = 0, height = 0;  // 0: the scene's resolution
   double aperture = -1.0;     // < 0: the scene's camera
   double focus = -1.0;
+  std::string shutter;  // OPEN,CLOSE in frames; empty: the cache's
 };
 
 const char* kUsage =
     "bench_render CACHE --frame F --spp N[,N...] [--ref-spp 1024] [--threads 2] [--runs 3]\n"
     "             [--out DIR] [--blender blender] [--script render_cycles.py]\n"
-    "             [--max-bounces 4] [--seed 1] [--resolution WxH] [--aperture R --focus D]\n";
+    "             [--max-bounces 4] [--seed 1] [--resolution WxH] [--aperture R --focus D]\n"
+    "             [--shutter OPEN,CLOSE]\n";
 
 Options parseArgs(int argc, char** argv) {
   Options o;
@@ -153,6 +160,8 @@ Options parseArgs(int argc, char** argv) {
       o.aperture = std::stod(value());
     } else if (a == "--focus") {
       o.focus = std::stod(value());
+    } else if (a == "--shutter") {
+      o.shutter = value();
     } else if (a == "--seed") {
       o.seed = std::stoull(value());
     } else if (a == "--help" || a == "-h") {
@@ -260,6 +269,38 @@ void writePropObj(const fs::path& path, const render::PropMesh& prop) {
     f << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
 }
 
+// A mesh's vertex positions at one motion-blur step, as an OBJ of v lines
+// (the same vertices, in the same order, as its mesh's OBJ).
+void writeStepObj(const fs::path& path, const std::vector<Vec3>& positions) {
+  auto f = openOut(path);
+  f << "# crumple motion-blur step: vertex positions only\n";
+  for (const Vec3& p : positions) f << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+}
+
+// The motion steps' OBJs of the sheet and the moving props, and their JSON
+// ("motion" of scene.json: null when nothing moves).
+std::string writeMotion(const fs::path& dir, const render::RenderScene& s, double shutterFrames) {
+  if (s.motionSteps() == 0) return "null";
+  const auto steps = [&](const std::vector<std::vector<Vec3>>& motion, const std::string& name) {
+    std::string list = "[";
+    for (std::size_t k = 0; k < motion.size(); ++k) {
+      const std::string file = name + "_step" + std::to_string(k) + ".obj";
+      writeStepObj(dir / file, motion[k]);
+      list += (k ? ", " : "") + quote(file);
+    }
+    return list + "]";
+  };
+  std::string json = "{\"shutterFrames\": " + num(shutterFrames) +
+                     ", \"steps\": " + std::to_string(s.motionSteps()) + ", \"sheet\": " +
+                     (s.sheetMotion.empty() ? "null" : steps(s.sheetMotion, "sheet")) +
+                     ", \"props\": [";
+  for (std::size_t i = 0; i < s.props.size(); ++i)
+    json += (i ? ", " : "") + (s.props[i].motion.empty()
+                                   ? std::string("null")
+                                   : steps(s.props[i].motion, "prop" + std::to_string(i)));
+  return json + "]}";
+}
+
 // The raw float image format shared with render_cycles.py: "RGBF", uint32
 // width, uint32 height (little-endian), float32 RGBA rows top to bottom.
 void writeRgbaf(const fs::path& path, const ImageRGBAF& image) {
@@ -290,7 +331,7 @@ ImageRGBAF readRgbaf(const fs::path& path) {
 }
 
 void writeSceneJson(const fs::path& path, const render::RenderScene& s, bool hasGround,
-                    int maxBounces, std::uint64_t seed) {
+                    int maxBounces, std::uint64_t seed, const std::string& motion) {
   auto f = openOut(path);
   const auto& c = s.camera;
   f << "{\n  \"camera\": {\"position\": " << vec(c.position) << ", \"rotation\": ["
@@ -336,7 +377,7 @@ void writeSceneJson(const fs::path& path, const render::RenderScene& s, bool has
     f << (i ? ", " : "") << "{\"obj\": \"prop" << i
       << ".obj\", \"name\": " << quote(s.props[i].name) << ", \"color\": " << vec(s.props[i].color)
       << "}";
-  f << "]\n}\n";
+  f << "],\n  \"motion\": " << motion << "\n}\n";
 }
 
 // --- Rendering ----------------------------------------------------------------
@@ -503,8 +544,18 @@ int run(const Options& o) {
   if (index == reader.frameCount())
     throw InputError(o.cache, "no frame " + std::to_string(o.frame) + " in the cache");
   const cache::FrameRecord record = reader.readFrame(index);
-  const pipeline::FrameViewBuilder builder(scene, header.extensions);
+  pipeline::FrameViewBuilder builder(scene, header.extensions);
+  if (!o.shutter.empty()) {
+    const auto comma = o.shutter.find(',');
+    if (comma == std::string::npos) throw InputError("bench_render: --shutter wants OPEN,CLOSE");
+    const cache::Shutter s{std::stod(o.shutter.substr(0, comma)),
+                           std::stod(o.shutter.substr(comma + 1))};
+    if (s.on() && !cache::decodeShutter(header.extensions))
+      throw InputError(o.cache, "--shutter: the cache holds no sub-frame motion");
+    builder.setShutter(s.on() ? s : cache::Shutter{});
+  }
   pipeline::FrameView fv = builder.build(record);
+  const double shutterFrames = builder.shutter().close - builder.shutter().open;
   if (o.width > 0) {
     fv.scene.camera.width = o.width;
     fv.scene.camera.height = o.height;
@@ -524,14 +575,17 @@ int run(const Options& o) {
     writePropObj(dir / ("prop" + std::to_string(i) + ".obj"), rs.props[i]);
   exporters::writePng((dir / "paper.png").string(), rs.paper.texture);
   writeRgbaf(dir / "paper.rgbaf", render::decodeSrgb8(rs.paper.texture, /*premultiply=*/false));
-  writeSceneJson(dir / "scene.json", rs, ground, o.maxBounces, o.seed);
+  writeSceneJson(dir / "scene.json", rs, ground, o.maxBounces, o.seed,
+                 writeMotion(dir, rs, shutterFrames));
 
   setThreadCount(o.threads);
   const std::string loadBefore = loadAverage();
   const std::uint64_t refSeed = o.seed + 1000;  // independent of the N-spp images
-  std::printf("bench_render: %s frame %d, %dx%d, %zu triangles, %d threads, %d runs\n",
+  std::printf("bench_render: %s frame %d, %dx%d, %zu triangles, %d threads, %d runs, %s\n",
               o.cache.c_str(), o.frame, rs.camera.width, rs.camera.height,
-              fv.sheet.triangles.size(), o.threads, o.runs);
+              fv.sheet.triangles.size(), o.threads, o.runs,
+              rs.motionSteps() > 0 ? ("motion blur over " + num(shutterFrames) + " frames").c_str()
+                                   : "no motion blur");
   std::fflush(stdout);
 
   // References: two halves of refSpp / 2 samples with independent seeds,
@@ -661,6 +715,7 @@ int run(const Options& o) {
     << ",\n  \"hardware_threads\": " << std::thread::hardware_concurrency()
     << ",\n  \"load_average_before\": " << quote(loadBefore)
     << ",\n  \"load_average_after\": " << quote(loadAfter) << ",\n  \"runs\": " << o.runs
+    << ",\n  \"motion_blur_frames\": " << num(rs.motionSteps() > 0 ? shutterFrames : 0.0)
     << ",\n  \"max_bounces\": " << o.maxBounces << ",\n  \"ref_spp\": " << 2 * half
     << ",\n  \"seed\": " << o.seed << ",\n  \"ref_seeds\": [" << refSeed << ", " << refSeed + 1
     << "],\n  \"covered_pixels\": " << count(covered) << ",\n  \"paper_pixels\": " << count(paper)

@@ -26,8 +26,9 @@ struct Args {
   std::string pass = "beauty";
   bool exr = false;
   bool noPng = false;
-  std::string aovs;    // --aov: a comma-separated list (render/aov.hpp)
-  std::string refine;  // --refine: auto, off or N (pipeline/refine.hpp); empty: the default
+  std::string aovs;     // --aov: a comma-separated list (render/aov.hpp)
+  std::string refine;   // --refine: auto, off or N (pipeline/refine.hpp); empty: the default
+  std::string shutter;  // --shutter as typed (parseShutter)
   bool contactSheet = false;
   bool movie = false;
   bool json = false;
@@ -57,6 +58,13 @@ pipeline::RenderSettings renderSettings(const Args& a);
 void addRenderOptions(CLI::App* cmd, Args& a);
 // --seed: a whole number in [0, 2^63 - 1] (InputError otherwise).
 std::uint64_t parseSeed(const std::string& text);
+// --shutter: OPEN,CLOSE in frames (-1 <= OPEN < CLOSE <= 1), or S, the
+// time it is open centred on the frame (0 <= S <= 2); 0 is closed (no motion
+// blur). InputError otherwise.
+cache::Shutter parseShutter(const std::string& text);
+// The help text of --shutter for `run`/`simulate` and for `render`.
+extern const char* const kShutterShotHelp;
+extern const char* const kShutterRenderHelp;
 
 // The commands; each returns the exit status or throws (main maps the
 // exception to the status).

@@ -1,6 +1,7 @@
 // The `crumple` commands that run a shot or read a cache: run, simulate,
 // render, sound, export, inspect, farm.
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <string>
@@ -103,10 +104,53 @@ std::uint64_t parseSeed(const std::string& text) {
   return seed;
 }
 
+const char* const kShutterShotHelp =
+    "motion blur: OPEN,CLOSE in frames relative to each frame's time, -1 <= OPEN < CLOSE <= 1 "
+    "(-0.25,0.25: a centred 180-degree shutter), or S for -S/2,S/2; 0 = none. Overrides the "
+    "scene's [camera] shutter: the cache stores the sheet's velocities (12 bytes per vertex per "
+    "frame) and `--backend embree` blurs the frames; osmesa draws them sharp";
+const char* const kShutterRenderHelp =
+    "motion blur: OPEN,CLOSE in frames relative to each frame's time, -1 <= OPEN < CLOSE <= 1, "
+    "or S for -S/2,S/2; 0 = none (default: the shutter the cache was simulated with, if any). An "
+    "open shutter needs a cache simulated with one ([camera] shutter or simulate --shutter: "
+    "its velocities), else exit 2; embree only, osmesa draws every frame sharp";
+
+cache::Shutter parseShutter(const std::string& text) {
+  const auto number = [&](const std::string& part) {
+    double v = 0.0;
+    const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
+    if (part.empty() || ec != std::errc() || end != part.data() + part.size() || !std::isfinite(v))
+      throw InputError("--shutter", "'" + text + "' is not OPEN,CLOSE or S (numbers of frames)");
+    return v;
+  };
+  cache::Shutter s;
+  if (const auto comma = text.find(','); comma != std::string::npos) {
+    s.open = number(text.substr(0, comma));
+    s.close = number(text.substr(comma + 1));
+    if (std::abs(s.open) > 1.0 || std::abs(s.close) > 1.0)
+      throw InputError("--shutter", "'" + text + "': OPEN and CLOSE must be in [-1, 1] frames");
+    if (!(s.open < s.close) && !(s.open == 0.0 && s.close == 0.0))
+      throw InputError("--shutter", "'" + text + "': the shutter must open before it closes");
+  } else {
+    const double length = number(text);
+    if (!(length >= 0.0 && length <= 2.0))
+      throw InputError("--shutter", "'" + text + "': S must be in [0, 2] frames");
+    s = {-0.5 * length, 0.5 * length};
+  }
+  if (!s.on()) return {};
+  return s;
+}
+
 int runOrSimulate(const Args& a, bool render) {
   setThreadCount(a.threads);
   setDebugOptions(parseDebugOptions(a.debug));
-  const auto scene = io::loadScene(io::resolveScenePath(a.scene));
+  auto scene = io::loadScene(io::resolveScenePath(a.scene));
+  if (!a.shutter.empty()) {
+    // As the scene's [camera] shutter: the cache records it (SHTR) and its velocities.
+    const cache::Shutter s = parseShutter(a.shutter);
+    scene.camera.shutterOpen = s.open;
+    scene.camera.shutterClose = s.close;
+  }
   pipeline::ShotOptions options;
   options.outDir = a.out;
   if (!a.frames.empty()) options.frames = pipeline::parseFrameRange(a.frames);
@@ -125,6 +169,7 @@ int renderCommand(const Args& a) {
   setThreadCount(a.threads);
   pipeline::RenderOptions options;
   options.rendering = renderSettings(a);
+  if (!a.shutter.empty()) options.rendering.shutter = parseShutter(a.shutter);
   if (!a.frames.empty()) options.frames = pipeline::parseFrameRange(a.frames);
   options.framesDir = a.out;
   options.debugStructure = a.debugStructure;

@@ -59,6 +59,7 @@ void addShotCommands(CLI::App& app, Args& a, Commands& c) {
         "tracer's samples)");
     cmd->add_option("--threads", a.threads, "worker threads; results are identical for any count")
         ->check(CLI::Range(1, 256));
+    cmd->add_option("--shutter", a.shutter, kShutterShotHelp);
     cmd->add_option("--checkpoint-every", a.checkpointEvery,
                     "N: write the whole simulation state to DIR/checkpoint.bin every N frames "
                     "(atomically)")
@@ -89,6 +90,7 @@ void addRenderCommand(CLI::App& app, Args& a, Commands& c) {
   c.render->add_option("CACHE", a.cache, "a .pcache file")->required();
   c.render->add_option("--frames", a.frames, "A-B: frames to render (default: every cached frame)");
   addRenderOptions(c.render, a);
+  c.render->add_option("--shutter", a.shutter, kShutterRenderHelp);
   c.render->add_option("--out", a.out,
                        "frames folder (default: frames/ beside the cache); locked while rendering "
                        "(exit 2 when another crumple writes there), shared by renders of a "

@@ -515,8 +515,78 @@ def setup_cycles(scene, spec, opts):
     return settings
 
 
+def read_positions(path):
+    """The v lines of an OBJ (a motion step written by bench_render)."""
+    out = []
+    with open(path) as f:
+        for line in f:
+            parts = line.split()
+            if parts and parts[0] == "v":
+                out.append(tuple(float(x) for x in parts[1:4]))
+    return out
+
+
+def add_motion(obj, step_files, base_dir, times):
+    """crumple's motion blur steps (RenderScene::sheetMotion, PropMesh::motion:
+    the vertices at K times evenly over the shutter, moving linearly between
+    them) as Cycles deformation motion blur: one shape key per step, its
+    value keyed 1 at its own time and 0 at the others (linear keys), so that
+    the evaluated mesh at any time of the shutter is the steps' piecewise
+    linear interpolation, exactly crumple's. Cycles samples the object at
+    2^motion_steps + 1 times evenly over the shutter and interpolates
+    linearly between them: enough that those times include every one of
+    crumple's when K - 1 is a power of two (K = 2: 3 times, the motion
+    linear between the two ends)."""
+    mesh = obj.data
+    obj.shape_key_add(name="Basis", from_mix=False)
+    keys = []
+    for k, name in enumerate(step_files):
+        positions = read_positions(os.path.join(base_dir, name))
+        if len(positions) != len(mesh.vertices):
+            raise SystemExit("render_cycles.py: %s has %d vertices, its mesh %d"
+                             % (name, len(positions), len(mesh.vertices)))
+        key = obj.shape_key_add(name="step%d" % k, from_mix=False)
+        key.data.foreach_set("co", [c for p in positions for c in p])
+        keys.append(key)
+    for k, key in enumerate(keys):
+        for j, t in enumerate(times):
+            key.value = 1.0 if j == k else 0.0
+            key.keyframe_insert("value", frame=t)
+    for fcurve in mesh.shape_keys.animation_data.action.fcurves:
+        for point in fcurve.keyframe_points:
+            point.interpolation = "LINEAR"
+    obj.cycles.use_motion_blur = True
+    obj.cycles.use_deform_motion = True
+    obj.cycles.motion_steps = max(1, math.ceil(math.log2(max(1, len(step_files) - 1))))
+
+
+def setup_motion(scene, spec, objects, base_dir):
+    """Motion blur as crumple's: the shutter open for shutterFrames frames,
+    centred on frame 1 (Blender's frame number is only a clock here: the
+    steps carry the positions), a box shutter (Cycles' default curve is
+    flat); the camera, lights and the rest stand still."""
+    motion = spec.get("motion")
+    if not motion:
+        return None
+    length = float(motion["shutterFrames"])
+    k = int(motion["steps"])
+    times = [1.0 - 0.5 * length + length * j / (k - 1) for j in range(k)]
+    if motion.get("sheet"):
+        add_motion(objects["sheet"], motion["sheet"], base_dir, times)
+    for i, steps in enumerate(motion.get("props") or []):
+        if steps:
+            add_motion(objects["prop%d" % i], steps, base_dir, times)
+    scene.frame_set(1)
+    scene.render.use_motion_blur = True
+    scene.render.motion_blur_shutter = length
+    scene.cycles.motion_blur_position = "CENTER"
+    scene.cycles.rolling_shutter_type = "NONE"
+    return {"shutter_frames": length, "steps": k, "key_times": times}
+
+
 def build_scene(spec, base_dir):
-    """Everything in SCENE.json into a fresh Blender scene."""
+    """Everything in SCENE.json into a fresh Blender scene; returns the
+    scene and its mesh objects by name."""
     # --factory-startup brings a cube, a light and a camera: remove them.
     for obj in list(bpy.data.objects):
         bpy.data.objects.remove(obj, do_unlink=True)
@@ -525,17 +595,20 @@ def build_scene(spec, base_dir):
     for i, light in enumerate(spec.get("lights", [])):
         make_light(i, light)
     make_world(spec["environment"])
+    objects = {}
     if spec.get("paper"):
         mat = paper_material(spec["paper"], base_dir)
-        make_mesh_object("sheet", os.path.join(base_dir, spec["paper"]["obj"]), mat)
+        objects["sheet"] = make_mesh_object(
+            "sheet", os.path.join(base_dir, spec["paper"]["obj"]), mat)
     if spec.get("ground"):
         g = spec["ground"]
         make_mesh_object("ground", os.path.join(base_dir, g["obj"]),
                          diffuse_material("ground", g["color"]))
     for i, prop in enumerate(spec.get("props", [])):
-        make_mesh_object("prop%d" % i, os.path.join(base_dir, prop["obj"]),
-                         diffuse_material("prop%d" % i, prop["color"]))
-    return scene
+        objects["prop%d" % i] = make_mesh_object(
+            "prop%d" % i, os.path.join(base_dir, prop["obj"]),
+            diffuse_material("prop%d" % i, prop["color"]))
+    return scene, objects
 
 
 # --- Output -------------------------------------------------------------------
@@ -655,8 +728,9 @@ def main():
         spec = json.load(f)
     base_dir = os.path.dirname(os.path.abspath(opts["scene"]))
     t0 = time.perf_counter()
-    scene = build_scene(spec, base_dir)
+    scene, objects = build_scene(spec, base_dir)
     settings = setup_cycles(scene, spec, opts)
+    settings["motion_blur"] = setup_motion(scene, spec, objects, base_dir)
     build_s = time.perf_counter() - t0
     wall, cpu, blender_s = render_timed(scene)
     out = os.path.abspath(opts["out"])

@@ -84,6 +84,13 @@ struct FrameRenderer::Impl {
                        "the structure view is drawn by the osmesa backend only");
     if (!embree && !settings.aovs.empty())
       throw InputError("--aov", "AOVs are computed by the embree backend only (--backend embree)");
+    // Motion blur: the path tracer's; the preview draws each frame's own positions.
+    const cache::Shutter shutter = settings.shutter.value_or(views.shutter());
+    if (shutter.on() && !cache::decodeShutter(headerBlocks))
+      throw InputError("--shutter",
+                       "the cache holds no sub-frame motion: simulate the shot with [camera] "
+                       "shutter (or run/simulate --shutter) to blur it");
+    views.setShutter(embree ? shutter : cache::Shutter{});
     render::RendererOptions options;
     options.width = scene.camera.width;
     options.height = scene.camera.height;

@@ -117,6 +117,12 @@ void ShotRunner::recordSheet(int frame) {
   if (tearAtlasBlock_) record_.extensions.push_back(*tearAtlasBlock_);
   if (structureBlock_) record_.extensions.push_back(*structureBlock_);
   if (developable) record_.extensions.push_back(std::move(*developable));
+  if (frameVelocities_) {  // motion blur: the sheet's velocities over the frame
+    detail::appendMotionBlocks(scene_, animation_.get(), frame, t,
+                               frameVelocities_->of(record_, 1.0 / scene_.fps),
+                               record_.positions.size(), record_.extensions);
+    frameVelocities_->remember(record_);
+  }
   record_.tearCount =
       tearStage_ ? static_cast<std::uint32_t>(tearStage_->tearing().startKinds().size()) : 0;
 }

@@ -15,6 +15,7 @@
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/refine.hpp"
 #include "crumple/pipeline/shot.hpp"
+#include "frame_motion.hpp"
 
 namespace crumple::pipeline {
 
@@ -188,6 +189,7 @@ FrameViewBuilder::FrameViewBuilder(const io::SceneSpec& scene,
       meshPropsAtRest_.push_back(std::move(m));
     }
   }
+  shutter_ = cache::decodeShutter(headerBlocks).value_or(cache::Shutter{});
 }
 
 FrameView FrameViewBuilder::build(const cache::FrameRecord& source) const {
@@ -243,6 +245,9 @@ FrameView FrameViewBuilder::build(const cache::FrameRecord& source) const {
                              " of the cache: TEAR sub-block: " + problem);
     fv.scene.tears = std::move(*tears);
   }
+  if (shutter_.on())
+    detail::addShutterMotion(fv.scene, fv.sheet, frame, shutter_, scene_.fps, boxes_.size(),
+                             meshPropsAtRest_);
   return fv;
 }
 

@@ -80,6 +80,10 @@ ShotRunner::ShotRunner(const io::SceneSpec& scene, const ShotOptions& options)
     (void)detail::cameraAt(scene, animation_.get(), time(f));
   // The look travels in the cache (texture, mesh props), read and checked now.
   lookBlocks_ = lookHeaderBlocks(scene, animation_.get());
+  if (auto shutter = detail::shutterBlock(scene)) {
+    lookBlocks_.push_back(std::move(*shutter));
+    frameVelocities_.emplace();
+  }
   // Tearing and sound events run only when the scene asks for them.
   if (plan_.tearing) {
     tearStage_.emplace(*sheet_.model, sheet_.context);
@@ -314,6 +318,10 @@ void ShotRunner::restore() {
   StateReader& in = *resumed_->state;
   for (const auto& section : stateSections()) section.restore(in);
   if (!in.atEnd()) in.fail("trailing bytes");
+  // Motion blur: the next frame's velocities start from the last cached one.
+  if (frameVelocities_ && resumed_->cachedFrames > 0)
+    frameVelocities_->remember(
+        cache::CacheReader(plan_.cachePath).readFrame(resumed_->cachedFrames - 1));
   if (plan_.log != nullptr)
     std::fprintf(plan_.log, "resuming after frame %d (%s)\n", resumed_->frame,
                  plan_.checkpointPath.c_str());

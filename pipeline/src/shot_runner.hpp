@@ -21,6 +21,7 @@
 #include "crumple/pipeline/output_lock.hpp"
 #include "crumple/pipeline/shot.hpp"
 #include "crumple/sound/events.hpp"
+#include "frame_motion.hpp"
 #include "frame_output.hpp"
 #include "shot_inputs.hpp"
 #include "shot_plan.hpp"
@@ -106,6 +107,8 @@ class ShotRunner {
   // The baked tear textures (TEAR block) of the current mesh, and the
   // crumpling model's structure changes of the frame being recorded.
   std::optional<cache::ExtensionBlock> tearAtlasBlock_, structureBlock_;
+  // Motion blur ([camera] shutter): the sheet's velocities over each frame.
+  std::optional<detail::FrameVelocities> frameVelocities_;
   std::unique_ptr<Progress> progress_;
   CostGuard guard_;
   ShotReport report_;

@@ -1,5 +1,6 @@
 // libFuzzer target: the cache reader, cache::CacheReader, and the decoders of
-// the sub-blocks crumple writes (TEAR, COLL/CONT, SNDS/SEVT, SGEO; docs/PCACHE.md).
+// the sub-blocks crumple writes (TEAR, COLL/CONT, SNDS/SEVT, SGEO, SHTR/VELO/PRPV;
+// docs/PCACHE.md).
 // Any input must either read or throw crumple::InputError (open) or
 // crumple::CorruptDataError (a damaged frame or sub-block); everything else
 // is a bug. Each input is read twice: as given, and with every chunk's CRC
@@ -13,6 +14,7 @@
 #include "crumple/cache/pcache.hpp"
 #include "crumple/cache/pcache_contacts.hpp"
 #include "crumple/cache/pcache_developable.hpp"
+#include "crumple/cache/pcache_motion.hpp"
 #include "crumple/cache/pcache_sound.hpp"
 #include "crumple/cache/pcache_tear.hpp"
 #include "crumple/core/crc32.hpp"
@@ -28,6 +30,7 @@ void readEverything(const crumple::cache::CacheReader& reader) {
   const cache::CacheHeader& header = reader.header();
   tolerateDamage([&] { return cache::decodeColliders(header.extensions); });
   tolerateDamage([&] { return cache::decodeSoundSetup(header.extensions); });
+  tolerateDamage([&] { return cache::decodeShutter(header.extensions); });
   (void)reader.verifyAll();
   for (std::size_t i = 0; i < reader.frameCount(); ++i) {
     (void)reader.frameNumber(i);
@@ -38,6 +41,8 @@ void readEverything(const crumple::cache::CacheReader& reader) {
       tolerateDamage([&] { return cache::decodeContacts(frame.extensions); });
       tolerateDamage([&] { return cache::decodeSoundEvents(frame.extensions); });
       tolerateDamage([&] { return cache::decodeDevelopable(frame); });
+      tolerateDamage([&] { return cache::decodeVelocities(frame.extensions); });
+      tolerateDamage([&] { return cache::decodePropVelocities(frame.extensions); });
       return 0;
     });
   }

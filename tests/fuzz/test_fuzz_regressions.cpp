@@ -21,6 +21,8 @@
 #include "crumple/cache/pcache.hpp"
 #include "crumple/cache/pcache_contacts.hpp"
 #include "crumple/cache/pcache_developable.hpp"
+#include "crumple/cache/pcache_look.hpp"
+#include "crumple/cache/pcache_motion.hpp"
 #include "crumple/cache/pcache_sound.hpp"
 #include "crumple/cache/pcache_tear.hpp"
 #include "crumple/core/error.hpp"
@@ -189,8 +191,9 @@ TEST(FuzzSeeds, BinaryGltfWithImpossibleLengthsIsRejectedBeforeAssimp) {
   }
 }
 
-// A tiny cache carrying every sub-block crumple writes (COLL and SNDS in the
-// header; CONT, TEAR, SEVT and SGEO in a frame) reads back equal through the
+// A tiny cache carrying every sub-block crumple writes (COLL, SNDS and SHTR
+// in the header; CONT, TEAR, SEVT, SGEO, VELO, PRPM and PRPV in a frame)
+// reads back equal through the
 // decoders and passes through the cache target. corpus/cache/blocks.pcache is
 // this file (CRUMPLE_FUZZ_SEED_OUT=path writes a copy there).
 TEST(FuzzSeeds, CacheWithEverySubBlockReadsBack) {
@@ -208,7 +211,9 @@ TEST(FuzzSeeds, CacheWithEverySubBlockReadsBack) {
   header.handleNames = {"a"};
   const std::vector<cache::ColliderInfo> colliders = {{"table", "wood", 0.4}};
   const cache::SoundSetupRecord setup{0.01, 20.0, 0.5, 0.02, 0.01, 0.005, 0.1};
-  header.extensions = {cache::encodeColliders(colliders), cache::encodeSoundSetup(setup)};
+  const cache::Shutter shutter{-0.25, 0.25};
+  header.extensions = {cache::encodeColliders(colliders), cache::encodeSoundSetup(setup),
+                       cache::encodeShutter(shutter)};
 
   cache::FrameRecord frame;
   frame.frame = 1;
@@ -238,13 +243,23 @@ TEST(FuzzSeeds, CacheWithEverySubBlockReadsBack) {
   event.amplitude = 1e-4;
   event.position = Vec3(0.05, 0, -0.05);
   event.resonators = {{0.05, 0.02, 1e-3, Vec3(0.05, 0, -0.05), Vec3::UnitY(), 0.02}};
-  frame.extensions = {cache::encodeContacts(contacts), cache::encodeTearAtlas(atlas),
-                      cache::encodeSoundEvents({event}), cache::encodeRegionRulings({{1, 0, 2}})};
+  // Velocities rounded to float as the block keeps them.
+  const std::vector<Vec3> velocities = {Vec3(0.5, 0, 0), Vec3(0.5, 0.25, 0), Vec3(0, 0, -1),
+                                        Vec3::Zero()};
+  crumple::Mat4 propVelocity = crumple::Mat4::Zero();
+  propVelocity(0, 3) = 1.0;
+  frame.extensions = {cache::encodeContacts(contacts),
+                      cache::encodeTearAtlas(atlas),
+                      cache::encodeSoundEvents({event}),
+                      cache::encodeVelocities(velocities),
+                      cache::encodePropMotions({crumple::Mat4::Identity()}),
+                      cache::encodePropVelocities({propVelocity}),
+                      cache::encodeRegionRulings({{1, 0, 2}})};
   {
     cache::CacheWriter writer(path.string(), header);
     writer.append(frame);
     frame.frame = 2;
-    frame.extensions.clear();
+    frame.extensions = {cache::encodeVelocities(std::vector<Vec3>(4, Vec3::Zero()))};
     writer.append(frame);
     writer.close();
   }
@@ -263,6 +278,11 @@ TEST(FuzzSeeds, CacheWithEverySubBlockReadsBack) {
     ASSERT_TRUE(developable.has_value());
     ASSERT_EQ(developable->regions.size(), 1u);
     EXPECT_EQ(developable->regions[0].apex, 0);
+    EXPECT_EQ(cache::decodeShutter(reader.header().extensions), shutter);
+    EXPECT_EQ(cache::decodeVelocities(first.extensions), velocities);
+    EXPECT_EQ(cache::decodePropVelocities(first.extensions),
+              std::vector<crumple::Mat4>{propVelocity});
+    EXPECT_TRUE(reader.verifyAll().empty());
   }
   const std::vector<std::uint8_t> bytes = readBytes(path);
   EXPECT_EQ(crumpleFuzz_cache(bytes.data(), bytes.size()), 0);

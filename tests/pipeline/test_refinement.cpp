@@ -129,10 +129,11 @@ TEST(Refinement, CrumplingSamplesStayIsometricAndKeepTheirFlatRegions) {
       EXPECT_EQ(again.sheet.positions, b.sheet.positions) << "deterministic";
       EXPECT_EQ(again.sheet.triangles, b.sheet.triangles);
     }
-    std::printf("[ measure ] %s: %d frames with curved regions, %d of %d runs refined (%d left "
-                "rough, %d by the isometry guard); c_mean at most %+.2e over the simulated "
-                "mesh's\n",
-                sample.c_str(), frames, refinedRuns, runs, rough, guarded, worst);
+    std::printf(
+        "[ measure ] %s: %d frames with curved regions, %d of %d runs refined (%d left "
+        "rough, %d by the isometry guard); c_mean at most %+.2e over the simulated "
+        "mesh's\n",
+        sample.c_str(), frames, refinedRuns, runs, rough, guarded, worst);
     EXPECT_GT(refinedRuns, 0) << sample << ": something was refined";
   }
 }
@@ -157,4 +158,46 @@ TEST(Refinement, OffDrawsTheSimulatedMesh) {
   ASSERT_TRUE(stats.has_value());
   EXPECT_EQ(stats->largestCells, 6);
   EXPECT_GT(f.triangles.size(), source.triangleCount());
+}
+
+// Motion blur on a refined frame: a shot simulated with a shutter keeps its
+// blur where the refinement adds vertices (their velocities interpolated in
+// the simulated triangles), both time steps with the refined mesh's count.
+TEST(Refinement, RefinedFramesCarryTheirMotionBlur) {
+  TempDir dir;
+  const std::string path = simulateSample("cylinder-fold", dir, 30, [](io::SceneSpec& s) {
+    s.camera.shutterOpen = -0.25;
+    s.camera.shutterClose = 0.25;
+  });
+  const cache::CacheReader reader(path);
+  const io::SceneSpec scene = io::parseScene(reader.header().sceneText, "cylinder-fold",
+                                             sourcePath("samples/cylinder-fold"), false);
+  const pipeline::FrameViewBuilder refined(scene, reader.header().extensions,
+                                           mesh::RefineOptions{});
+  const pipeline::FrameViewBuilder plain(scene, reader.header().extensions);
+  const cache::FrameRecord f = reader.readFrame(reader.frameCount() - 1);  // mid-wrap
+  const pipeline::FrameView a = plain.build(f);
+  const pipeline::FrameView b = refined.build(f);
+  ASSERT_TRUE(b.refined.has_value());
+  ASSERT_GT(b.sheet.vertexCount(), a.sheet.vertexCount());
+  ASSERT_EQ(b.scene.sheetMotion.size(), 2u);
+  for (const auto& step : b.scene.sheetMotion) ASSERT_EQ(step.size(), b.sheet.vertexCount());
+  // The simulated vertices move as without refinement; the sheet moves.
+  double moved = 0.0;
+  for (std::size_t v = 0; v < a.sheet.vertexCount(); ++v) {
+    const Vec3 da = a.scene.sheetMotion[1][v] - a.scene.sheetMotion[0][v];
+    const Vec3 db = b.scene.sheetMotion[1][v] - b.scene.sheetMotion[0][v];
+    EXPECT_LT((da - db).norm(), 1e-6) << v;
+    moved = std::max(moved, da.norm());
+  }
+  EXPECT_GT(moved, 1e-4) << "the wrap moves the sheet during the shutter";
+  // A new vertex moves about as its neighbours on the surface do.
+  double worst = 0.0;
+  for (std::size_t v = a.sheet.vertexCount(); v < b.sheet.vertexCount(); ++v) {
+    const Vec3 d = b.scene.sheetMotion[1][v] - b.scene.sheetMotion[0][v];
+    const int near = mesh::nearestPatternVertex(a.sheet, b.sheet.pattern[v]);
+    worst =
+        std::max(worst, (d - (a.scene.sheetMotion[1][near] - a.scene.sheetMotion[0][near])).norm());
+  }
+  EXPECT_LT(worst, 0.5 * moved);
 }

@@ -5,12 +5,15 @@
 // elastic and on the crumpling model.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <optional>
 #include <regex>
 #include <string>
 #include <vector>
 
+#include "crumple/cache/pcache.hpp"
+#include "crumple/cache/pcache_motion.hpp"
 #include "crumple/exporters/png.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/pipeline/shot.hpp"
@@ -215,4 +218,21 @@ TEST(Resume, AGustyAirShotResumesToTheSameBytes) {
   // Checkpoints at frames 13 and 26: the resume simulates 27-34 again, in the gust.
   expectResumedSummaryIsTheWholeOne(scene, tmp / "out", 13, false,
                                     pipeline::FrameRange{scene.frameStart, 34});
+}
+
+TEST(Resume, AShotWithAShutterResumesToTheSameBytes) {
+  // Motion blur: the first frame simulated again takes its velocities from
+  // the last cached frame (the one before it), as the whole run did.
+  const TempDir tmp;
+  writeSmallScene(tmp / "s");
+  io::SceneSpec scene = io::loadScene((tmp / "s/scene.toml").string());
+  scene.camera.shutterOpen = -0.25;  // as `--shutter -0.25,0.25` sets it
+  scene.camera.shutterClose = 0.25;
+  expectResumedSummaryIsTheWholeOne(scene, tmp / "out", 4, false);
+  const cache::CacheReader reader((tmp / "out/cache.pcache").string());
+  const auto last = cache::decodeVelocities(reader.readFrame(reader.frameCount() - 1).extensions);
+  ASSERT_TRUE(last.has_value());
+  double fastest = 0.0;
+  for (const Vec3& v : *last) fastest = std::max(fastest, v.norm());
+  EXPECT_GT(fastest, 1e-3) << "the handles move the sheet in the frames resumed";
 }

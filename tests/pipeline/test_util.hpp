@@ -247,3 +247,44 @@ inline std::array<std::string, 2> cachesOnOneAndTwoThreads(const std::string& ar
 }
 
 }  // namespace crumple::testing
+
+namespace crumple::testing {
+
+// A glTF with one mesh node "Cup" (a triangle) whose translation moves from
+// (0, 0, 0) at t = 0 to (1, 0, 0) at t = 1 s.
+inline std::string movingPropGltf() {
+  std::vector<std::uint8_t> buf;
+  auto putF = [&](float f) {
+    std::uint8_t b[4];
+    std::memcpy(b, &f, 4);
+    buf.insert(buf.end(), b, b + 4);
+  };
+  for (const float f : {0.f, 0.f, 0.f, 0.1f, 0.f, 0.f, 0.f, 0.1f, 0.f}) putF(f);  // 36 bytes
+  for (const std::uint16_t i : {std::uint16_t{0}, std::uint16_t{1}, std::uint16_t{2},
+                                std::uint16_t{0}}) {  // 8 bytes (padded)
+    buf.push_back(static_cast<std::uint8_t>(i & 0xff));
+    buf.push_back(static_cast<std::uint8_t>(i >> 8));
+  }
+  for (const float f : {0.f, 1.f}) putF(f);                      // times: 8 bytes at 44
+  for (const float f : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f}) putF(f);  // translations: 24 bytes at 52
+  return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+  "nodes": [{"name": "Cup", "mesh": 0}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+  "buffers": [{"byteLength": )" +
+         std::to_string(buf.size()) + R"(, "uri": "data:application/octet-stream;base64,)" +
+         base64(buf) + R"("}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
+                  {"buffer": 0, "byteOffset": 36, "byteLength": 6},
+                  {"buffer": 0, "byteOffset": 44, "byteLength": 8},
+                  {"buffer": 0, "byteOffset": 52, "byteLength": 24}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                 "min": [0, 0, 0], "max": [0.1, 0.1, 0]},
+                {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"},
+                {"bufferView": 2, "componentType": 5126, "count": 2, "type": "SCALAR",
+                 "min": [0], "max": [1]},
+                {"bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3"}],
+  "animations": [{"channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
+                  "samplers": [{"input": 2, "output": 3, "interpolation": "LINEAR"}]}]})";
+}
+
+}  // namespace crumple::testing

@@ -10,6 +10,7 @@
 #include <iostream>
 #include <numbers>
 
+#include "crumple/cache/pcache_motion.hpp"
 #include "crumple/cache/pcache_tear.hpp"
 #include "crumple/core/error.hpp"
 #include "crumple/io/scene.hpp"
@@ -299,6 +300,77 @@ TEST(TearRender, TheCacheCarriesTheAtlasToTheRenderers) {
   EXPECT_THROW(views.build(frame), CorruptDataError);
   frame.extensions.clear();
   EXPECT_TRUE(views.build(frame).scene.tears.empty());
+}
+
+}  // namespace
+}  // namespace crumple::tear
+
+namespace crumple::tear {
+namespace {
+
+// Motion blur (docs/RENDERING.md "Motion blur"): the torn sheet sliding
+// along +x while the shutter is open, from the cache's frame (its TEAR and
+// VELO blocks, a shot's shutter), is the average of the still sheet at the
+// places it passes: the masks cut the paper where the moving triangles
+// carry them.
+TEST(TearRender, AMovingTornSheetIsTheAverageOfItsPlacesWhileTheShutterIsOpen) {
+  const TornScene s = tornScene();
+  constexpr double kMove = 0.002;  // m while the shutter is open: 20 pixels
+  cache::FrameRecord frame;
+  frame.frame = 3;
+  frame.pattern = s.sheet.pattern;
+  frame.positions = s.sheet.positions;
+  frame.triangles = s.sheet.triangles;
+  frame.regionOfTriangle = s.sheet.regionOfTriangle;
+  frame.regionTypes = {0};
+  frame.extensions = {cache::encodeTearAtlas(s.atlas),
+                      cache::encodeVelocities(
+                          std::vector<Vec3>(s.sheet.vertexCount(), Vec3(kMove * 24.0, 0.0, 0.0)))};
+  const io::SceneSpec spec =
+      io::parseScene("[scene]\nfps = 24\n[sheet]\nwidth = 0.04\nheight = 0.04\n", "torn.toml", ".");
+  const pipeline::FrameViewBuilder views(spec, {cache::encodeShutter({-0.5, 0.5})});
+  const pipeline::FrameView fv = views.build(frame);
+  ASSERT_EQ(fv.scene.sheetMotion.size(), 2u);
+  EXPECT_EQ(fv.scene.tears, s.atlas);
+  const Vec2 centre = viewCentre(s);
+  render::RenderScene scene = viewOf(s, centre);
+  render::EmbreeRenderer embree;
+  render::PathTraceSettings pt;
+  pt.pass = render::RenderPass::Albedo;
+  const auto render = [&](const render::RenderScene& sc, const mesh::SheetMesh& sheet, int spp) {
+    pt.samplesPerPixel = spp;
+    return embree.render(sc, sheet, pt);
+  };
+  const ImageRGBAF sharp = render(scene, s.sheet, 16);
+  scene.sheetMotion = fv.scene.sheetMotion;
+  const ImageRGBAF blurred = render(scene, s.sheet, 256);
+  // The still sheet at 41 places evenly over the motion (half a pixel apart).
+  scene.sheetMotion.clear();
+  std::vector<double> mean(static_cast<std::size_t>(kPixels * kPixels), 0.0);
+  constexpr int kPlaces = 41;
+  for (int k = 0; k < kPlaces; ++k) {
+    mesh::SheetMesh moved = s.sheet;
+    for (Vec3& p : moved.positions) p.x() += kMove * (static_cast<double>(k) / (kPlaces - 1) - 0.5);
+    const ImageRGBAF still = render(scene, moved, 4);
+    for (int y = 0; y < kPixels; ++y)
+      for (int x = 0; x < kPixels; ++x)
+        mean[static_cast<std::size_t>(y * kPixels + x)] += still.at(x, y)[3] / kPlaces;
+  }
+  double toMean = 0.0, toSharp = 0.0;
+  for (int y = 0; y < kPixels; ++y)
+    for (int x = 0; x < kPixels; ++x) {
+      const double b = blurred.at(x, y)[3];
+      toMean += std::abs(b - mean[static_cast<std::size_t>(y * kPixels + x)]);
+      toSharp += std::abs(b - sharp.at(x, y)[3]);
+    }
+  toMean /= kPixels * kPixels;
+  toSharp /= kPixels * kPixels;
+  std::cout << "[ measure ] blurred torn sheet: mean |alpha difference| to the average of its "
+            << kPlaces << " places " << toMean << ", to the still sheet " << toSharp << "\n";
+  // Measured 0.0020 against 0.059: the sampling noise of the partly covered
+  // pixels (256 samples blurred, 41 x 4 averaged) and the places' spacing.
+  EXPECT_LT(toMean, 0.006);
+  EXPECT_GT(toSharp, 10.0 * toMean);
 }
 
 }  // namespace

@@ -9,6 +9,8 @@
 
 #include "crumple/cache/pcache.hpp"
 #include "crumple/cache/pcache_contacts.hpp"
+#include "crumple/cache/pcache_look.hpp"
+#include "crumple/cache/pcache_motion.hpp"
 #include "crumple/core/error.hpp"
 
 namespace crumple::cache {
@@ -118,6 +120,27 @@ std::string contactProblem(const FrameRecord& f, const CacheHeader& h) {
   return {};
 }
 
+// Sub-frame motion: a shot simulated for a shutter (SHTR) carries the
+// sheet's velocities in every frame, one per vertex, and with mesh props
+// their motions' derivatives, one per prop.
+std::string motionProblem(const FrameRecord& f, const CacheHeader& h) {
+  const bool shutter = decodeShutter(h.extensions).has_value();
+  const auto velocities = decodeVelocities(f.extensions);
+  if (shutter && !velocities) return "VELO sub-block: missing (the header has a shutter)";
+  if (velocities && velocities->size() != f.positions.size())
+    return "VELO sub-block: " + num(velocities->size()) + " velocities for " +
+           num(f.positions.size()) + " vertices";
+  const auto props = decodePropVelocities(f.extensions);
+  if (!props && !shutter) return {};
+  const auto motions = decodePropMotions(f.extensions);
+  const std::size_t nMotions = motions ? motions->size() : 0;
+  if (props && props->size() != nMotions)
+    return "PRPV sub-block: " + num(props->size()) + " prop velocities for " + num(nMotions) +
+           " prop motions";
+  if (shutter && motions && !props) return "PRPV sub-block: missing (the header has a shutter)";
+  return {};
+}
+
 }  // namespace
 
 std::string validate(const CacheHeader& h) {
@@ -132,6 +155,11 @@ std::string validate(const CacheHeader& h) {
         std::pair{h.paperThickness, "paper thickness"}})
     if (!std::isfinite(value) || value < 0.0)
       return std::string(name) + " " + std::to_string(value) + " is not a length";
+  try {
+    (void)decodeShutter(h.extensions);
+  } catch (const CorruptDataError& e) {
+    return e.what();
+  }
   return {};
 }
 
@@ -146,7 +174,8 @@ std::string validate(const FrameRecord& f, const CacheHeader& h) {
       !std::isfinite(c.yfov) || c.yfov < 0.0 || c.yfov >= std::numbers::pi)
     return "camera: not a finite pose with a field of view in [0, pi)";
   try {
-    return contactProblem(f, h);
+    if (auto p = contactProblem(f, h); !p.empty()) return p;
+    return motionProblem(f, h);
   } catch (const CorruptDataError& e) {
     return e.what();
   }

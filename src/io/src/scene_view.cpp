@@ -20,13 +20,49 @@ namespace {
 constexpr std::int64_t kMaxResolution = 16384;
 constexpr std::int64_t kMaxPixels = std::int64_t{1} << 27;
 
+// `shutter`: [open, close] in frames relative to the frame's time, or one
+// number s, the fraction of a frame it is open, centred on the frame
+// ([-s/2, s/2]). 0 (or [0, 0]) is no motion blur. Within a frame of the
+// frame's time: the cache's velocities extrapolate the sheet linearly from
+// it (docs/RENDERING.md "Motion blur").
+void parseShutter(const TableReader& r, CameraSpec& c) {
+  const toml::node* node = r.find("shutter");
+  if (!node) return;
+  double open = 0.0, close = 0.0;
+  if (node->is_array()) {
+    const Vec2 v = *r.vec2("shutter");
+    open = v.x();
+    close = v.y();
+    if (std::abs(open) > 1.0 || std::abs(close) > 1.0)
+      r.fail("shutter",
+             "open and close must be within 1 frame of the frame's time, in [-1, 1] "
+             "(got [" +
+                 formatNumber(open) + ", " + formatNumber(close) + "])");
+    if (!(open < close) && !(open == 0.0 && close == 0.0))
+      r.fail("shutter", "the shutter must open before it closes (got [" + formatNumber(open) +
+                            ", " + formatNumber(close) + "]); 0 or [0, 0]: no motion blur");
+  } else {
+    const double s = *r.number("shutter");
+    if (!(s >= 0.0 && s <= 2.0))
+      r.fail("shutter",
+             "must be in [0, 2] frames, the time the shutter is open centred on the "
+             "frame (got " +
+                 formatNumber(s) + "), or [open, close]");
+    open = -0.5 * s;
+    close = 0.5 * s;
+  }
+  c.shutterOpen = open + 0.0;  // no -0.0
+  c.shutterClose = close + 0.0;
+  c.shutterLine = r.lineOf("shutter");
+}
+
 }  // namespace
 
 void SceneParser::parseCamera(const toml::table* table) {
   if (!table) return;
   const TableReader r(*table, "camera", file_);
   r.allowOnly({"node", "position", "look_at", "up", "fov_deg", "focal_mm", "sensor_mm",
-               "resolution", "f_stop", "focus_distance"});
+               "resolution", "f_stop", "focus_distance", "shutter"});
   CameraSpec& c = spec_.camera;
   if (auto res = r.intPair("resolution")) {
     for (std::int64_t v : *res) {
@@ -90,6 +126,7 @@ void SceneParser::parseCamera(const toml::table* table) {
     if (!(c.fStop > 0.0)) r.fail("focus_distance", "needs f_stop (depth of field)");
     c.focusDistance = r.requirePositive("focus_distance", *d) * mpu();
   }
+  parseShutter(r, c);
 }
 
 void SceneParser::parseLights(const TableReader& root) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "crumple/cache/pcache.hpp"
+#include "crumple/cache/pcache_motion.hpp"
 #include "crumple/io/animation.hpp"
 #include "crumple/io/scene.hpp"
 #include "crumple/mesh/developable.hpp"
@@ -48,6 +49,10 @@ struct RenderSettings {
   // The crumpling model's curved regions refined (refine.hpp); nullopt: auto
   // for embree, off for osmesa. Off under the structure view.
   std::optional<mesh::RefineOptions> refine;
+  // Embree: the motion blur's shutter (`render --shutter`); nullopt: the
+  // one the cache was simulated for (FrameViewBuilder). An open shutter
+  // needs a cache with sub-frame motion (InputError otherwise).
+  std::optional<cache::Shutter> shutter;
   bool contactSheet = false;  // contact_sheet.png in the shot's folder (beside the cache)
   bool movie = false;         // preview.mp4 there through ffmpeg, with its sound.wav if any
 };
@@ -246,6 +251,12 @@ render::RenderScene makeRenderScene(const io::SceneSpec& scene, const cache::Cam
 // crumpling model (its SGEO block) gets its curved regions refined: Auto
 // measures the density on the frame's camera; the tear patches follow their
 // triangles.
+//
+// Motion blur (docs/RENDERING.md "Motion blur"): with a shutter, the view's
+// sheetMotion and its moving mesh props' motion hold their positions at the
+// shutter's opening and closing, from the frame's velocities (VELO, PRPV).
+// The shutter is the one the cache was simulated for (its header's SHTR;
+// none without); setShutter replaces it (closed: every frame sharp).
 struct FrameView {
   render::RenderScene scene;
   mesh::SheetMesh sheet;
@@ -262,6 +273,8 @@ class FrameViewBuilder {
     o.mode = mesh::RefineMode::Off;
     return o;
   }
+  void setShutter(const cache::Shutter& shutter) { shutter_ = shutter; }
+  const cache::Shutter& shutter() const { return shutter_; }
 
  private:
   const io::SceneSpec& scene_;
@@ -269,6 +282,7 @@ class FrameViewBuilder {
   ImageRGBA8 texture_;
   std::vector<render::PropMesh> boxes_;
   std::vector<render::PropMesh> meshPropsAtRest_;
+  cache::Shutter shutter_;
 };
 
 // The cache header's look blocks (docs/PCACHE.md): "PTEX", the [paper]

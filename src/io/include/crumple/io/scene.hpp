@@ -92,6 +92,15 @@ struct CameraSpec {
   double sensorWidth = 0.036;  // m
   // m along the view axis; 0 = the distance to look_at (fixed camera) or 1 m.
   double focusDistance = 0.0;
+  // Motion blur (the path tracer only; docs/RENDERING.md "Motion blur"): the
+  // shutter is open from shutterOpen to shutterClose, in frames relative to
+  // the frame's time, -1 <= open < close <= 1 (e.g. -0.25, 0.25: a centred
+  // 180-degree shutter). Both 0: no motion blur, and the cache stores no
+  // sub-frame motion.
+  double shutterOpen = 0.0;
+  double shutterClose = 0.0;
+  long shutterLine = 0;  // scene file line of `shutter` (for errors)
+  bool motionBlur() const { return shutterClose > shutterOpen; }
 };
 
 struct LightSpec {
