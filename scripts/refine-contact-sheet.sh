@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# The simulated mesh against the refined surface (docs/RENDERING.md
+# The simulated mesh against the production look (docs/RENDERING.md
 # "Refinement"): simulates the sample (once), renders the frames with the
-# path tracer with --refine off and with the default, and lays them out side
-# by side (left off, right refined; tests/golden/image_grid.cpp) into
-# docs/images/refine-SAMPLE.png.
+# path tracer twice, left as simulated and sharp (--refine off --shutter 0),
+# right as `render` draws them by default (refined, with the motion blur of
+# the sample's [camera] shutter if it has one), and lays them out side by
+# side (tests/golden/image_grid.cpp) into docs/images/refine-SAMPLE.png.
 #
 #   scripts/refine-contact-sheet.sh [SAMPLE] [FRAMES]   (default cylinder-fold "30 42 70 96")
 #
@@ -27,11 +28,11 @@ fi
 cells=()
 for f in $frames; do
   printf -v name '%04d' "$f"
-  for refine in off auto; do
-    "$build/crumple" render "$out/$sample/cache.pcache" --frames "$f-$f" --backend embree \
-      --spp "$spp" --refine "$refine" --out "$out/$sample/$refine" >/dev/null 2>&1
-    cells+=("$f=$out/$sample/$refine/$name.png")
-  done
+  "$build/crumple" render "$out/$sample/cache.pcache" --frames "$f-$f" --backend embree \
+    --spp "$spp" --refine off --shutter 0 --out "$out/$sample/plain" >/dev/null
+  "$build/crumple" render "$out/$sample/cache.pcache" --frames "$f-$f" --backend embree \
+    --spp "$spp" --out "$out/$sample/look" >/dev/null
+  cells+=("$f=$out/$sample/plain/$name.png" "$f=$out/$sample/look/$name.png")
 done
 "$build/tests/golden/image_grid" "$root/docs/images/refine-$sample.png" 2 "$cell" "${cells[@]}"
 echo "docs/images/refine-$sample.png"
