@@ -13,10 +13,10 @@
 
 #include "crumple/cache/pcache.hpp"
 #include "crumple/cache/pcache_tear.hpp"
-#include "crumple/io/scene.hpp"
-#include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/exporters/mesh_export.hpp"
+#include "crumple/io/scene.hpp"
 #include "crumple/mesh/developable.hpp"
+#include "crumple/mesh/sheet_mesh.hpp"
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/refine.hpp"
 #include "crumple/pipeline/shot.hpp"

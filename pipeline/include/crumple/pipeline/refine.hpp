@@ -22,10 +22,10 @@ std::string refineName(const mesh::RefineOptions& options);
 // one (the source's vertices keep their indices, so the singular, junction
 // and handle vertices and the rulings still name the same points), its
 // TEAR patches follow their triangles and its VELO velocities (motion blur)
-// cover the new vertices, interpolated in the source triangles. Returns the refinement's figures, or
-// nullopt when nothing was done. Handles and singular vertices are pinned,
-// triangles with a tear patch locked. Throws CorruptDataError naming the
-// frame for an SGEO block that does not fit its mesh.
+// cover the new vertices, interpolated in the source triangles. Returns the refinement's figures,
+// or nullopt when nothing was done. Handles and singular vertices are pinned, triangles with a tear
+// patch locked. Throws CorruptDataError naming the frame for an SGEO block that does not fit its
+// mesh.
 std::optional<mesh::RefineStats> refineFrame(cache::FrameRecord& frame,
                                              const mesh::RefineOptions& options);
 
