@@ -2,7 +2,7 @@
 // runs of faces the refinement folds (developable.hpp).
 #include <algorithm>
 #include <cmath>
-#include <set>
+#include <stdexcept>
 #include <string>
 
 #include "crumple/core/index.hpp"
@@ -58,72 +58,47 @@ std::vector<std::vector<int>> trianglesOfVertices(const SheetMesh& sheet) {
   return out;
 }
 
-// The boundary edges run with the sheet on their left (triangles are
-// counter-clockwise in the pattern); each loop is sampled at its vertices in
-// its pattern arc length, breaks (C0) at the outline's corners, where the
-// loop touches itself, where the region beside it changes and at
-// `breakVertex` (paper Sec. 6.2; the corners as the crumpling model's own
-// boundary curve has them).
+// Each boundary loop (boundaryLoops: the sheet on its left) sampled at its
+// vertices in its pattern arc length, breaks (C0) at the outline's corners,
+// where the region beside it changes and at `breakVertex` (paper Sec. 6.2;
+// the corners as the crumpling model's own boundary curve has them). A
+// boundary that is not a set of simple loops (two loops touching at a
+// vertex) gets no curves: every side stays straight.
 BoundaryCurves::BoundaryCurves(const SheetMesh& sheet, std::span<const char> breakVertex) {
-  std::map<std::pair<int, int>, int> count;  // undirected edge -> uses
-  std::map<std::pair<int, int>, int> triangleOf;
+  std::vector<std::vector<int>> loops;
+  try {
+    loops = boundaryLoops(sheet);
+  } catch (const std::invalid_argument&) {
+    return;
+  }
+  std::map<std::pair<int, int>, int> regionOf;  // directed edge -> region of its triangle
   for (std::size_t t = 0; t < sheet.triangles.size(); ++t)
-    for (int k = 0; k < 3; ++k) {
-      const int a = sheet.triangles[t][idx(k)], b = sheet.triangles[t][idx((k + 1) % 3)];
-      ++count[{std::min(a, b), std::max(a, b)}];
-      triangleOf[{a, b}] = static_cast<int>(t);
-    }
-  std::map<int, std::vector<int>> out;  // vertex -> next vertices along boundary edges
-  std::vector<std::pair<int, int>> directed;
-  for (const auto& [ab, t] : triangleOf)
-    if (count[{std::min(ab.first, ab.second), std::max(ab.first, ab.second)}] == 1) {
-      out[ab.first].push_back(ab.second);
-      directed.push_back(ab);
-    }
-  std::set<std::pair<int, int>> used;
-  for (const auto& start : directed) {
-    if (used.contains(start)) continue;
-    std::vector<int> loop;
-    std::vector<int> region;
-    std::pair<int, int> e = start;
-    bool closed = false;
-    while (!used.contains(e)) {
-      used.insert(e);
-      loop.push_back(e.first);
-      region.push_back(sheet.regionOfTriangle[idx(triangleOf[e])]);
-      int next = -1;
-      for (int c : out[e.second])
-        if (!used.contains({e.second, c})) {
-          next = c;
-          break;
-        }
-      if (next < 0) {
-        closed = e.second == start.first;  // back where it started
-        break;
-      }
-      e = {e.second, next};
-    }
+    for (int k = 0; k < 3; ++k)
+      regionOf[{sheet.triangles[t][idx(k)], sheet.triangles[t][idx((k + 1) % 3)]}] =
+          sheet.regionOfTriangle[t];
+  for (const std::vector<int>& loop : loops) {
     const std::size_t n = loop.size();
-    if (n < 3 || !closed) continue;  // an open chain: its sides stay straight
+    if (n < 3) continue;
     std::vector<BoundarySample> samples;
     std::vector<double> breaks;
     double s = 0.0;
     const int id = static_cast<int>(curves_.size());
+    std::vector<std::pair<std::pair<int, int>, EdgeOnLoop>> edges;
     for (std::size_t i = 0; i < n; ++i) {
       const int v = loop[i], w = loop[(i + 1) % n], u = loop[(i + n - 1) % n];
       const Vec2 din = sheet.pattern[idx(v)] - sheet.pattern[idx(u)];
       const Vec2 dout = sheet.pattern[idx(w)] - sheet.pattern[idx(v)];
       const double turn = std::atan2(cross2(din, dout), din.dot(dout));
-      if (std::abs(turn) > 1e-6 || out[v].size() > 1 || breakVertex[idx(v)] != 0 ||
-          region[i] != region[(i + n - 1) % n])
+      if (std::abs(turn) > 1e-6 || breakVertex[idx(v)] != 0 || regionOf[{u, v}] != regionOf[{v, w}])
         breaks.push_back(s);
       samples.push_back({s, sheet.positions[idx(v)]});
       const double length = dout.norm();
-      edges_[{v, w}] = {id, s, length};
+      edges.push_back({{v, w}, {id, s, length}});
       s += length;
     }
     if (!(s > 0.0)) continue;
     curves_.emplace_back(std::move(samples), s, breaks);
+    edges_.insert(edges.begin(), edges.end());
   }
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 #include "crumple/core/index.hpp"
@@ -196,6 +197,40 @@ SheetMesh restoreSheetMesh(StateReader& in) {
     for (int v : t)
       if (!inRange(m.pattern, v)) in.fail("a triangle's vertex is out of range");
   return m;
+}
+
+std::vector<std::vector<int>> boundaryLoops(const SheetMesh& mesh) {
+  // Each boundary edge, oriented as its triangle runs it (counter-clockwise
+  // triangles: the sheet on the edge's left).
+  std::map<int, int> next;
+  for (const MeshEdge& e : buildEdges(mesh)) {
+    if (e.interior()) continue;
+    const auto& t = mesh.triangles[static_cast<std::size_t>(e.triangles[0])];
+    int from = e.v[0], to = e.v[1];
+    for (int k = 0; k < 3; ++k)
+      if (t[static_cast<std::size_t>(k)] == e.v[1] &&
+          t[static_cast<std::size_t>((k + 1) % 3)] == e.v[0])
+        std::swap(from, to);
+    if (!next.emplace(from, to).second)
+      throw std::invalid_argument("boundaryLoops: two boundary loops touch at vertex " +
+                                  std::to_string(from));
+  }
+  std::vector<std::vector<int>> loops;
+  while (!next.empty()) {
+    std::vector<int> loop;
+    int v = next.begin()->first;  // the lowest vertex left
+    while (true) {
+      const auto it = next.find(v);
+      if (it == next.end()) break;
+      loop.push_back(v);
+      v = it->second;
+      next.erase(it);
+    }
+    if (v != loop.front())
+      throw std::invalid_argument("boundaryLoops: a boundary that does not close");
+    loops.push_back(std::move(loop));
+  }
+  return loops;
 }
 
 }  // namespace crumple::mesh

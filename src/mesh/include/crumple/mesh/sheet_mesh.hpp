@@ -41,6 +41,14 @@ struct MeshEdge {
 // non-manifold edge (three or more triangles).
 std::vector<MeshEdge> buildEdges(const SheetMesh& mesh);
 
+// The boundary loops of the mesh's pattern: each a closed sequence of vertex
+// indices along boundary edges, with the sheet on its left (counter-
+// clockwise around the outline, clockwise around a hole). Loops start at
+// their lowest vertex and are sorted by it. Throws std::invalid_argument for
+// a boundary that is not a set of simple loops (a vertex where two loops
+// touch).
+std::vector<std::vector<int>> boundaryLoops(const SheetMesh& mesh);
+
 // Checkpoint and resume: the whole mesh (pattern, positions,
 // triangles, regions) in a state; restoreSheetMesh throws CorruptDataError
 // for indices out of range or sizes that do not match.

@@ -21,13 +21,8 @@ struct TearCandidate {
   bool operator==(const TearCandidate&) const = default;
 };
 
-// The boundary loops of the mesh's pattern: each a closed sequence of vertex
-// indices along boundary edges, with the sheet on its left (counter-
-// clockwise around the outline, clockwise around a hole). Loops start at
-// their lowest vertex and are sorted by it. Throws std::invalid_argument for
-// a boundary that is not a set of simple loops (a vertex where two loops
-// touch).
-std::vector<std::vector<int>> boundaryLoops(const mesh::SheetMesh& mesh);
+// The boundary loops of the mesh's pattern (mesh/sheet_mesh.hpp).
+using mesh::boundaryLoops;
 
 // The boundary vertices where the sheet's interior angle in the pattern
 // exceeds pi + minAngle (rad, >= 0): an inward corner, a notch's root.
