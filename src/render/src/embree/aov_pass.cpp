@@ -120,8 +120,9 @@ void AovPixel::add(const RTCRayHit& rh, const Surface& s) {
   }
   count(objects_, m.objectId);
   if (m.kind == GeomKind::Sheet) {
-    const SheetTri& t = f_.sheet.tris[rh.hit.primID];
-    const float weights[3] = {1.0f - rh.hit.u - rh.hit.v, rh.hit.u, rh.hit.v};
+    const TriangleHit h = triangleHit(m, rh.hit.primID, rh.hit.u, rh.hit.v);
+    const SheetTri& t = f_.sheet.tris[h.triangle];
+    const float weights[3] = {1.0f - h.u - h.v, h.u, h.v};
     bool singular = false;
     for (int k = 0; k < 3; ++k)
       singular |= (t.singularCorners >> k & 1u) != 0 && weights[k] >= kSingularNeighbourhood;

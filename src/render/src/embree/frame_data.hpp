@@ -36,8 +36,15 @@ struct MeshData {
   std::vector<V3> vertices;  // relative to the origin; one padding element for Embree's loads
   std::vector<std::array<std::uint32_t, 3>> triangles;
   std::vector<V3> faceNormals;  // unit, counter-clockwise front; zero when degenerate
-  V3 color;                     // ground and props
-  float objectId = 0.0f;        // the AOVs' object id: 1 sheet, 2 ground, 3 + k prop k
+  // What Embree traces (pairIntoQuads, quad_pairs.hpp): quads (q0, q1, q2, q3)
+  // that Embree splits into (q0, q1, q3) and (q2, q3, q1), each the two
+  // triangles of quadTriangles (the second kNoTriangle for a lone triangle
+  // drawn as (a, b, c, c)); a hit's primID is a quad (triangleHit).
+  static constexpr std::uint32_t kNoTriangle = 0xFFFFFFFFu;
+  std::vector<std::array<std::uint32_t, 4>> quads;
+  std::vector<std::array<std::uint32_t, 2>> quadTriangles;
+  V3 color;               // ground and props
+  float objectId = 0.0f;  // the AOVs' object id: 1 sheet, 2 ground, 3 + k prop k
   // Motion blur: the vertices and face normals at each time step (vertices
   // padded as `vertices`); empty when the mesh is still over the shutter.
   std::vector<std::vector<V3>> steps;
@@ -68,6 +75,23 @@ struct SheetLook {
   // the sheet is still).
   std::vector<std::vector<std::array<V3, 3>>> stepNormals;
 };
+
+// A hit on a triangle: its index in MeshData::triangles and barycentrics
+// (u, v) of its corners 1 and 2.
+struct TriangleHit {
+  std::uint32_t triangle = 0;
+  float u = 0.0f, v = 0.0f;
+};
+
+// The triangle and barycentrics of Embree's hit (u, v) on quad `prim`:
+// the quad's first triangle below its diagonal (u + v <= 1), else the
+// second, whose corners (q2, q3, q1) weigh (u + v - 1, 1 - u, 1 - v)
+// (Embree manual, RTC_GEOMETRY_TYPE_QUAD).
+inline TriangleHit triangleHit(const MeshData& m, unsigned prim, float u, float v) {
+  const auto& pair = m.quadTriangles[prim];
+  if (u + v <= 1.0f || pair[1] == MeshData::kNoTriangle) return {pair[0], u, v};
+  return {pair[1], 1.0f - u, 1.0f - v};
+}
 
 // Coordinates at barycentrics (u, v) of a triangle's three corners.
 inline Vec2 interpolate(const std::array<float, 6>& c, float u, float v) {

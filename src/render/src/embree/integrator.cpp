@@ -66,8 +66,9 @@ TriangleAt triangleAt(const MeshData& m, unsigned prim, float time) {
 
 Surface makeSurface(const FrameData& f, const RTCRayHit& rh, V3 dir, float time) {
   const MeshData& m = f.meshes[rh.hit.geomID];
-  const unsigned prim = rh.hit.primID;
-  const float u = rh.hit.u, v = rh.hit.v;
+  const TriangleHit hit = triangleHit(m, rh.hit.primID, rh.hit.u, rh.hit.v);
+  const unsigned prim = hit.triangle;
+  const float u = hit.u, v = hit.v;
   const TriangleAt tri = triangleAt(m, prim, time);
   Surface s;
   s.p = tri.a + (tri.b - tri.a) * u + (tri.c - tri.a) * v;

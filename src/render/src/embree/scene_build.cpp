@@ -9,6 +9,7 @@
 
 #include "aov_pass.hpp"
 #include "crumple/core/parallel.hpp"
+#include "quad_pairs.hpp"
 
 namespace crumple::render::pt {
 
@@ -37,17 +38,19 @@ const char* errorName(RTCError e) {
 
 // Embree intersect/occluded filter: rejects sheet hits where the texture's
 // bilinear alpha is below 0.5 (cut-outs) or, on a tear patch, its mask is
-// (view.hpp), for every kind of ray.
+// (view.hpp), for every kind of ray. The user data is the FrameData.
 void alphaCutFilter(const RTCFilterFunctionNArguments* args) {
-  const auto* look = static_cast<const SheetLook*>(args->geometryUserPtr);
+  const auto* f = static_cast<const FrameData*>(args->geometryUserPtr);
+  const SheetLook& look = f->sheet;
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] == 0) continue;
-    const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
-    const float u = RTCHitN_u(args->hit, args->N, i);
-    const float v = RTCHitN_v(args->hit, args->N, i);
-    const SheetTri& t = look->tris[prim];
-    if (sampleTexture(*look->texture, sheetUv(t, u, v)).w() < 0.5 ||
-        (t.masked && mesh::sampleTearMask(*look->tears, interpolate(t.maskUv, u, v)) < 0.5))
+    const MeshData& m = f->meshes[RTCHitN_geomID(args->hit, args->N, i)];
+    const TriangleHit h =
+        triangleHit(m, RTCHitN_primID(args->hit, args->N, i), RTCHitN_u(args->hit, args->N, i),
+                    RTCHitN_v(args->hit, args->N, i));
+    const SheetTri& t = look.tris[h.triangle];
+    if (sampleTexture(*look.texture, sheetUv(t, h.u, h.v)).w() < 0.5 ||
+        (t.masked && mesh::sampleTearMask(*look.tears, interpolate(t.maskUv, h.u, h.v)) < 0.5))
       args->valid[i] = 0;
   }
 }
@@ -225,10 +228,11 @@ CameraData makeCamera(const Camera& cam) {
   return c;
 }
 
-// Attaches a triangle geometry over m's (shared) buffers to the scene.
-void attach(EmbreeDevice& device, RTCScene scene, MeshData& m, SheetLook* filterLook) {
+// Attaches a quad geometry over m's (shared) buffers to the scene, with
+// the alpha-cut filter reading `filterFrame` when given.
+void attach(EmbreeDevice& device, RTCScene scene, MeshData& m, FrameData* filterFrame) {
   const std::unique_ptr<RTCGeometryTy, decltype(&rtcReleaseGeometry)> g(
-      rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_TRIANGLE), &rtcReleaseGeometry);
+      rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_QUAD), &rtcReleaseGeometry);
   if (!g) device.check("rtcNewGeometry");
   m.vertices.push_back(V3{});  // padding: Embree may read 16 bytes at the last vertex
   if (m.steps.empty()) {
@@ -244,10 +248,10 @@ void attach(EmbreeDevice& device, RTCScene scene, MeshData& m, SheetLook* filter
                                  RTC_FORMAT_FLOAT3, step.data(), 0, sizeof(V3), step.size() - 1);
     }
   }
-  rtcSetSharedGeometryBuffer(g.get(), RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                             m.triangles.data(), 0, sizeof(m.triangles[0]), m.triangles.size());
-  if (filterLook != nullptr) {
-    rtcSetGeometryUserData(g.get(), filterLook);
+  rtcSetSharedGeometryBuffer(g.get(), RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4, m.quads.data(), 0,
+                             sizeof(m.quads[0]), m.quads.size());
+  if (filterFrame != nullptr) {
+    rtcSetGeometryUserData(g.get(), filterFrame);
     rtcSetGeometryIntersectFilterFunction(g.get(), alphaCutFilter);
     rtcSetGeometryOccludedFilterFunction(g.get(), alphaCutFilter);
   }
@@ -352,6 +356,7 @@ FrameData buildFrameData(const RenderScene& scene, const mesh::SheetMesh& sheet,
   f.environment = toV3(env);
   f.hasEnvironment = !isBlack(f.environment);
   f.camera = makeCamera(g.camera);
+  for (MeshData& m : f.meshes) pairIntoQuads(m, m.kind == GeomKind::Sheet ? &f.sheet : nullptr);
   return f;
 }
 
@@ -364,7 +369,7 @@ ScenePtr buildScene(EmbreeDevice& device, FrameData& f, bool cutSheet) {
   rtcSetSceneBuildQuality(scene.get(),
                           triangles <= 200000 ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
   for (MeshData& m : f.meshes)
-    attach(device, scene.get(), m, m.kind == GeomKind::Sheet && cutSheet ? &f.sheet : nullptr);
+    attach(device, scene.get(), m, m.kind == GeomKind::Sheet && cutSheet ? &f : nullptr);
   rtcCommitScene(scene.get());
   device.check("rtcCommitScene");
   return scene;
