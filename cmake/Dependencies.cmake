@@ -5,6 +5,7 @@ find_package(Threads REQUIRED)
 find_package(Eigen3 3.4 REQUIRED CONFIG)
 find_package(assimp 5.2 REQUIRED CONFIG)
 find_package(PNG REQUIRED)
+find_package(ZLIB REQUIRED)  # FBX arrays (src/io/src/fbx_takes.cpp)
 find_package(CLI11 REQUIRED CONFIG)
 find_package(tomlplusplus REQUIRED CONFIG)  # target tomlplusplus::tomlplusplus
 # CGAL 5.5 is header-only on Debian; CGAL::CGAL carries Boost's headers, GMP,

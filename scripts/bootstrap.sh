@@ -8,7 +8,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libsuitesparse-dev libopenblas0
-  libassimp-dev libosmesa6-dev libpng-dev libembree-dev libopenexr-dev openexr libfcl-dev
+  libassimp-dev libosmesa6-dev libpng-dev zlib1g-dev libembree-dev libopenexr-dev openexr libfcl-dev
   libtomlplusplus-dev libcli11-dev
   libsndfile1-dev libfftw3-dev
   libcgal-dev libgmp-dev libmpfr-dev

@@ -256,13 +256,15 @@ TEST(AnimationImporters, ColladaUnitAndUpAxisAreBakedIntoTheRootByAssimp) {
   EXPECT_FALSE(dae.hasNode("handle_node"));
 }
 
-TEST(AnimationImporters, FbxKeyTimesStartAtTheFirstKeyWithoutTakeRange) {
-  // shifted.fbx keys at 0.5 s and 1.5 s, no LocalStart/LocalStop: assimp 5.2.5
-  // subtracts the first key time, so the track starts at 0.
+TEST(AnimationImporters, FbxKeysWithoutTakeRangeKeepTheirTimes) {
+  // shifted.fbx (ASCII) keys at 0.5 s and 1.5 s, no LocalStart/LocalStop:
+  // assimp 5.2.5 subtracts the first key time; crumple reads the first key
+  // from the file and puts it back.
   const AnimationScene s = AnimationScene::load(data("shifted.fbx"));
-  EXPECT_NEAR(s.startTime(), 0.0, 1e-9);
-  EXPECT_NEAR(s.endTime(), 1.0, 1e-9);
-  EXPECT_VEC_NEAR(s.worldPose("Handle", 0.5).position, Vec3(0.5, 0, 0), kTol);
+  EXPECT_NEAR(s.startTime(), 0.5, 1e-9);
+  EXPECT_NEAR(s.endTime(), 1.5, 1e-9);
+  EXPECT_VEC_NEAR(s.worldPose("Handle", 0.5).position, Vec3(0, 0, 0), kTol);
+  EXPECT_VEC_NEAR(s.worldPose("Handle", 1.0).position, Vec3(0.5, 0, 0), kTol);
 }
 
 TEST(AnimationImporters, FbxWithZeroFrameRateIsAnError) {

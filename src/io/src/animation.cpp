@@ -19,6 +19,7 @@
 #include <unordered_map>
 
 #include "crumple/core/error.hpp"
+#include "fbx_takes.hpp"
 #include "import_probe.hpp"
 
 namespace crumple::io {
@@ -207,7 +208,8 @@ struct AnimationScene::Impl {
   std::string file;
   Format format = Format::Other;
   Mat4 fileToWorld = Mat4::Identity();
-  std::vector<Node> nodes;  // parents before children
+  std::vector<detail::FbxTake> fbxTakes;  // FBX: the takes as the file states them
+  std::vector<Node> nodes;                // parents before children
   std::unordered_map<std::string, int> byName;
   std::set<std::string> duplicates;
   std::vector<ImportedMesh> meshes;  // in mesh-local coordinates
@@ -304,13 +306,13 @@ struct AnimationScene::Impl {
   }
 
   template <class Key, class Value, class Convert>
-  void readKeys(const Key* keys, unsigned count, double tps, const std::string& node,
+  void readKeys(const Key* keys, unsigned count, double tps, double shift, const std::string& node,
                 const char* what, std::vector<double>& times, std::vector<Value>& values,
                 Convert convert) {
     std::vector<std::pair<double, Value>> kv;
     kv.reserve(count);
     for (unsigned i = 0; i < count; ++i) {
-      const double t = ticksToSeconds(keys[i].mTime, tps);
+      const double t = ticksToSeconds(keys[i].mTime, tps) + shift;
       Value v = convert(keys[i].mValue);
       if (!std::isfinite(t)) {
         fail("node '" + node + "': non-finite time in " + what + " key " + std::to_string(i));
@@ -334,8 +336,29 @@ struct AnimationScene::Impl {
     }
   }
 
+  // FBX: the time assimp took off the keys of the take that animation
+  // `name` comes from, to be put back (fbx_takes.hpp); 0 for other formats.
+  double keyShift(const std::string& name) const {
+    if (format != Format::Fbx) return 0.0;
+    for (const detail::FbxTake& take : fbxTakes)
+      if (take.name == name) return detail::assimpKeyShift(take);
+    return fbxTakes.size() == 1 ? detail::assimpKeyShift(fbxTakes.front()) : 0.0;
+  }
+
   void addAnimations(const aiScene* scene) {
     bool any = false;
+    if (format == Format::Fbx && fbxTakes.size() > 1 &&
+        std::any_of(fbxTakes.begin(), fbxTakes.end(), [](const detail::FbxTake& take) {
+          return take.name.find('|') != std::string::npos;
+        })) {
+      // Blender's "All Actions" / "NLA Strips" export: a take per object and
+      // action, each restarted at 0 from the action's first frame.
+      warnings.push_back(
+          "the file has " + std::to_string(fbxTakes.size()) + " takes named like Blender's " +
+          "per-action export ('" + fbxTakes.front().name +
+          "'): their keys start at each action's first frame, not at the scene's frames; " +
+          "export with All Actions and NLA Strips off for one take of the scene");
+    }
     for (unsigned a = 0; a < scene->mNumAnimations; ++a) {
       const aiAnimation* anim = scene->mAnimations[a];
       const std::string animName =
@@ -352,6 +375,7 @@ struct AnimationScene::Impl {
         warnings.push_back("animation '" + animName + "' gives no ticks per second; assuming " +
                            fmt(kFallbackTicksPerSecond));
       }
+      const double shift = keyShift(animName);
       for (unsigned c = 0; c < anim->mNumChannels; ++c) {
         const aiNodeAnim* ch = anim->mChannels[c];
         const std::string name = ch->mNodeName.C_Str();
@@ -369,11 +393,11 @@ struct AnimationScene::Impl {
         }
         node.animated = true;
         NodeKeys& k = node.keys;
-        readKeys(ch->mPositionKeys, ch->mNumPositionKeys, tps, name, "position", k.positionTimes,
-                 k.positions, toVec3);
-        readKeys(ch->mRotationKeys, ch->mNumRotationKeys, tps, name, "rotation", k.rotationTimes,
-                 k.rotations, toQuat);
-        readKeys(ch->mScalingKeys, ch->mNumScalingKeys, tps, name, "scaling", k.scalingTimes,
+        readKeys(ch->mPositionKeys, ch->mNumPositionKeys, tps, shift, name, "position",
+                 k.positionTimes, k.positions, toVec3);
+        readKeys(ch->mRotationKeys, ch->mNumRotationKeys, tps, shift, name, "rotation",
+                 k.rotationTimes, k.rotations, toQuat);
+        readKeys(ch->mScalingKeys, ch->mNumScalingKeys, tps, shift, name, "scaling", k.scalingTimes,
                  k.scalings, toVec3);
         for (std::size_t i = 0; i < k.rotations.size(); ++i) {
           const double norm = k.rotations[i].norm();
@@ -517,7 +541,10 @@ AnimationScene AnimationScene::load(const std::string& path) {
   auto impl = std::make_unique<Impl>();
   impl->file = path;
   impl->format = detectFormat(scene, path);
-  if (impl->format == Format::Fbx) impl->fileToWorld = fbxFileToWorld(scene, path);
+  if (impl->format == Format::Fbx) {
+    impl->fileToWorld = fbxFileToWorld(scene, path);
+    impl->fbxTakes = detail::readFbxTakes(path);
+  }
   impl->addNodes(scene->mRootNode, -1);
   impl->addMeshes(scene);
   impl->addAnimations(scene);
