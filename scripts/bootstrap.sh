@@ -13,7 +13,7 @@ PACKAGES=(
   libsndfile1-dev libfftw3-dev
   libcgal-dev libgmp-dev libmpfr-dev
   libgtest-dev libbenchmark-dev
-  gnuplot-nox python3
+  gnuplot-nox python3 ffmpeg
   "$@"
 )
 

@@ -51,6 +51,8 @@ struct Args {
   // farm
   pipeline::SlurmOptions slurm;
   bool dryRun = false;
+  // init
+  bool force = false;
 };
 
 // How frames are drawn, from the options `run` and `render` share.
@@ -75,5 +77,6 @@ int compareCommand(const Args& a);
 int exportCommand(const Args& a);
 int inspectCommand(const Args& a);
 int farmCommand(const Args& a, const CLI::App& slurm);
+int initCommand(const Args& a);
 
 }  // namespace crumple::cli

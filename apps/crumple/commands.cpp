@@ -17,6 +17,7 @@
 #include "crumple/pipeline/inspect.hpp"
 #include "crumple/pipeline/refine.hpp"
 #include "crumple/pipeline/sound.hpp"
+#include "crumple/pipeline/starter.hpp"
 #include "crumple/render/aov.hpp"
 
 namespace crumple::cli {
@@ -270,6 +271,17 @@ int farmCommand(const Args& a, const CLI::App& slurm) {
       jobs.simulate.c_str(), jobs.render.c_str(), s.chunks.size() - 1, s.frames.first,
       s.frames.last, a.slurm.chunk, jobs.finalize.c_str(), s.farmDir.c_str(), s.logsDir.c_str(),
       s.outDir.c_str());
+  return 0;
+}
+
+// `crumple init`: the starter shot (pipeline/starter.hpp).
+int initCommand(const Args& a) {
+  pipeline::writeStarterShot(a.scene, a.force);
+  std::printf(
+      "starter shot written:\n  scene:     %s/scene.toml (commented; docs/SCENE.md has every "
+      "key)\n  animation: %s/gather.gltf (the four corner handles)\nrun it with:\n  crumple "
+      "run %s\n",
+      a.scene.c_str(), a.scene.c_str(), a.scene.c_str());
   return 0;
 }
 

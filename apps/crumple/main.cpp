@@ -32,6 +32,7 @@ struct Commands {
   CLI::App* farm = nullptr;
   CLI::App* farmSlurm = nullptr;
   CLI::App* bench = nullptr;
+  CLI::App* init = nullptr;
 };
 
 // `run` and `simulate`: a shot from its scene.
@@ -186,6 +187,17 @@ void addCacheCommands(CLI::App& app, Args& a, Commands& c) {
                           "A-B: frames to export (default: every cached frame)");
 }
 
+// `init`: a starter shot.
+void addInitCommand(CLI::App& app, Args& a, Commands& c) {
+  c.init = app.add_subcommand(
+      "init",
+      "Write a starter shot into DIR: scene.toml, commented key by key, and gather.gltf, four "
+      "corner handles gathering a 20 cm sheet of office paper (crumpling model, camera, lights, "
+      "ground, sound). Run it with `crumple run DIR`.");
+  c.init->add_option("DIR", a.scene, "the folder to write (created when missing)")->required();
+  c.init->add_flag("--force", a.force, "replace DIR's scene.toml and gather.gltf if there");
+}
+
 // `farm slurm` and `farm movie`.
 void addFarmCommand(CLI::App& app, Args& a, Commands& c) {
   c.farm = app.add_subcommand("farm", "Run a shot on a render farm (docs/FARM.md).");
@@ -264,6 +276,7 @@ int dispatch(const Commands& c, const Args& a) {
     if (*c.compare) return compareCommand(a);
     if (*c.exportCmd) return exportCommand(a);
     if (*c.farm) return farmCommand(a, *c.farmSlurm);
+    if (*c.init) return initCommand(a);
     return 1;
   });
 }
@@ -287,6 +300,7 @@ int main(int argc, char** argv) {
   addCacheCommands(app, a, c);
   addFarmCommand(app, a, c);
   addBenchCommand(app, a, c);
+  addInitCommand(app, a, c);
 
   // A first word that is neither an option nor a command is named, with the commands.
   if (argc > 1 && argv[1][0] != '-') {
