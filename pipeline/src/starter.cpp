@@ -171,10 +171,12 @@ v_axis = [0.0, 0.0, -1.0]      # the pattern's height direction
 preset = "office-70gsm"  # or "office-90gsm" (assets/papers)
 
 [model]
-type = "hybrid"          # the crumpling model (flat and curved regions, singular points);
-                         # "elastic" for a plain elastic sheet. Drawn in further, a gather
-                         # reaches the crumpling model's current limits: its handles then
-                         # lag behind their nodes (a warning says so, docs/CRUMPLING.md).
+type = "hybrid"          # the crumpling model (flat and curved regions, singular points).
+                         # Four pinched corners drawn together are its hard case: even this
+                         # gentle gather ends with warnings that the handles lag behind
+                         # their nodes by up to 1 mm on a few frames (docs/CRUMPLING.md).
+                         # "elastic" (a plain elastic sheet) runs it without warnings, but
+                         # makes no crumpling sounds.
 
 # One handle per corner: `node` is the animation node it follows, `pattern`
 # the point of the sheet it holds (in the pattern, cm), `tangent_control`

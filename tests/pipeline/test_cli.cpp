@@ -16,7 +16,7 @@ TEST(Cli, HelpForEverySubcommand) {
   const auto top = runCrumple("--help");
   EXPECT_EQ(top.status, 0);
   for (const char* sub :
-       {"run", "simulate", "render", "sound", "export", "farm", "inspect", "compare"}) {
+       {"run", "simulate", "render", "sound", "export", "farm", "inspect", "compare", "init"}) {
     EXPECT_NE(top.output.find(sub), std::string::npos) << sub;
     const auto r = runCrumple(std::string(sub) + " --help");
     EXPECT_EQ(r.status, 0) << sub;
@@ -26,6 +26,29 @@ TEST(Cli, HelpForEverySubcommand) {
   EXPECT_EQ(runCrumple("frobnicate").status, 2);
   EXPECT_EQ(runCrumple("run").status, 2) << "SCENE is required";
   EXPECT_EQ(runCrumple("sound").status, 2) << "CACHE is required";
+}
+
+// `crumple init DIR` writes a starter shot that `crumple run` takes as is:
+// frames, cache, a soundtrack with crumpling events; a second init into the
+// same folder is refused unless --force.
+TEST(Cli, InitWritesAStarterShotThatRuns) {
+  const TempDir tmp;
+  const fs::path dir = tmp.path() / "starter";
+  const auto init = runCrumple("init " + dir.string());
+  ASSERT_EQ(init.status, 0) << init.output;
+  EXPECT_TRUE(fs::exists(dir / "scene.toml"));
+  EXPECT_TRUE(fs::exists(dir / "gather.gltf"));
+  EXPECT_NE(readFile(dir / "scene.toml").find("# "), std::string::npos) << "commented";
+  const auto run = runCrumple("run " + dir.string() + " --out " + (dir / "out").string());
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_TRUE(fs::exists(dir / "out" / "cache.pcache"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "frames" / "0072.png"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "sound.wav"));
+  EXPECT_EQ(run.output.find("sound    0 crumpling"), std::string::npos) << run.output;
+  const auto again = runCrumple("init " + dir.string());
+  EXPECT_EQ(again.status, 2) << again.output;
+  EXPECT_NE(again.output.find("--force"), std::string::npos) << again.output;
+  EXPECT_EQ(runCrumple("init " + dir.string() + " --force").status, 0);
 }
 
 TEST(Cli, RunWritesCacheFramesSummaryAndProgressLines) {
