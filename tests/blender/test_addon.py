@@ -7,7 +7,8 @@ run by scripts/blender-addon-test.sh inside Blender 3.4:
 It installs the add-on from its zip, builds the cylinder-fold shot in Blender
 (a 10 cm plane and four corner empties keyed from
 samples/cylinder-fold/make_cylinder_fold_gltf.py's corner_pose, converted to
-Blender's Z-up), writes the scene twice (byte-identical scene.toml),
+Blender's Z-up), writes the scene twice (byte-identical scene.toml, whose
+handles and sheet corners are where the empties and the plane are),
 simulates it through the operator (synchronously) with [sound], and checks,
 at several frames, what came back against crumple's own outputs:
   - the mesh shown is that frame's, with `crumple inspect --json`'s vertex
@@ -56,6 +57,10 @@ def check(ok, what):
 
 def gltf_to_blender(p):
     return Vector((p[0], -p[2], p[1]))
+
+
+def blender_to_gltf(p):
+    return (p[0], p[2], -p[1])
 
 
 def build_scene(folder, first=1, last=102):
@@ -121,8 +126,32 @@ def ply_bounds(path):
 
 def mesh_bounds(obj):
     world = [obj.matrix_world @ v.co for v in obj.data.vertices]
-    yup = [(w.x, w.z, -w.y) for w in world]
+    yup = [blender_to_gltf(w) for w in world]
     return [min(p[k] for p in yup) for k in range(3)], [max(p[k] for p in yup) for k in range(3)]
+
+
+def check_scene_file(scene, folder, sheet, handles):
+    """scene.toml's geometry against Blender's at the first frame, converted
+    to Y up here: every handle's pattern point is where its empty is, the
+    sheet's corners where the plane's are (1e-6 m). crumple pins the corners
+    to their nodes whatever the file says, so only this sees a wrong axis in
+    the writer."""
+    import tomllib
+    spec = tomllib.load(open(os.path.join(folder, "scene.toml"), "rb"))
+    s = spec["sheet"]
+
+    def place(u, v):
+        return Vector(s["origin"]) + u * Vector(s["u_axis"]) + v * Vector(s["v_axis"])
+
+    scene.frame_set(scene.frame_start)
+    yup = {h.name: Vector(blender_to_gltf(h.matrix_world.translation)) for h in handles}
+    err = max((place(*h["pattern"]) - yup[h["node"]]).length for h in spec["handles"])
+    corners = [blender_to_gltf(sheet.matrix_world @ v.co) for v in sheet.data.vertices]
+    want = [place(u, v) for u in (0.0, s["width"]) for v in (0.0, s["height"])]
+    cerr = max(min((Vector(c) - w).length for c in corners) for w in want)
+    check(len(spec["handles"]) == len(handles) and err < 1e-6 and cerr < 1e-6,
+          "scene.toml: %d handles on their empties (%.1e m), sheet corners on the plane's "
+          "(%.1e m)" % (len(spec["handles"]), err, cerr))
 
 
 def expect_error(op, text, what, **kwargs):
@@ -246,6 +275,7 @@ def main():
         texts.append(open(os.path.join(folder, "scene.toml"), "rb").read())
     check(texts[0] == texts[1], "scene.toml written twice is byte-identical (%d bytes)"
           % len(texts[0]))
+    check_scene_file(scene, folder, scene.crumple.sheet, handles)
     t = time.monotonic()
     result = bpy.ops.crumple.simulate(synchronous=True)
     check(result == {"FINISHED"}, "simulate + import: %s in %.1f s" % (result, time.monotonic() - t))
@@ -264,4 +294,5 @@ def main():
     sys.exit(1 if FAILED else 0)
 
 
-main()
+if __name__ == "__main__":
+    main()
