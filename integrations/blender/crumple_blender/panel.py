@@ -33,16 +33,15 @@ class CRUMPLE_PT_scene(bpy.types.Panel):
         handles = [o.name for o in context.scene.objects if o.crumple.role == "HANDLE"]
         colliders = [o.name for o in context.scene.objects if o.crumple.role == "COLLIDER"]
         layout.label(text="Handles: %s" % (", ".join(sorted(handles)) or "none (Object > Crumple)"))
-        row = layout.row()
-        row.label(text="Colliders: %d" % len(colliders))
-        row.operator("crumple.add_colliders")
+        layout.label(text="Colliders: %d" % len(colliders))
+        layout.operator("crumple.add_colliders")
         if job.find_crumple(context) is None:
             layout.label(text="crumple not found: set it in the add-on preferences",
                          icon="ERROR")
-        row = layout.row(align=True)
-        row.operator("crumple.write_scene", icon="FILE_TICK")
-        row.operator("crumple.simulate", icon="PLAY")
-        row.operator("crumple.import_result", icon="IMPORT")
+        col = layout.column(align=True)
+        col.operator("crumple.write_scene", icon="FILE_TICK")
+        col.operator("crumple.simulate", icon="PLAY")
+        col.operator("crumple.import_result", icon="IMPORT")
         if operators._current is not None:
             row = layout.row()
             row.prop(settings, "progress", slider=True, text=settings.status)
