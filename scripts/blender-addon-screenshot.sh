@@ -7,15 +7,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 out="${1:-$root/docs/images/blender-panel.png}"
-crumple="${CRUMPLE_BIN:-}"
-if [[ -z "$crumple" ]]; then
-  if [[ -x "${CRUMPLE_BUILD_DIR:-$root/build}/crumple" ]]; then
-    crumple="${CRUMPLE_BUILD_DIR:-$root/build}/crumple"
-  else
-    crumple="$(command -v crumple || true)"
-  fi
-fi
-[[ -n "$crumple" && -x "$crumple" ]] || { echo "blender-addon-screenshot: no crumple binary (set CRUMPLE_BIN)" >&2; exit 2; }
+source "$root/scripts/crumple-bin.sh"
 blender="${BLENDER:-blender}"
 if [[ -z "${BLENDER:-}" ]]; then bash "$root/scripts/bootstrap.sh" blender python3-numpy xvfb; fi
 work="$(mktemp -d "${TMPDIR:-/tmp}/crumple-shot.XXXXXX")"

@@ -16,16 +16,7 @@ if [[ "${1:-}" == "-h" || "${1:-}" == "--help" ]]; then
   awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "${BASH_SOURCE[0]}"
   exit 0
 fi
-crumple="${CRUMPLE_BIN:-}"
-if [[ -z "$crumple" ]]; then
-  if [[ -x "${CRUMPLE_BUILD_DIR:-$root/build}/crumple" ]]; then
-    crumple="${CRUMPLE_BUILD_DIR:-$root/build}/crumple"
-  else
-    crumple="$(command -v crumple || true)"
-  fi
-fi
-[[ -n "$crumple" && -x "$crumple" ]] || { echo "blender-addon-test: no crumple binary (set CRUMPLE_BIN)" >&2; exit 2; }
-crumple="$(cd "$(dirname "$crumple")" && pwd)/$(basename "$crumple")"
+source "$root/scripts/crumple-bin.sh"
 blender="${BLENDER:-blender}"
 if [[ -z "${BLENDER:-}" ]]; then bash "$root/scripts/bootstrap.sh" blender python3-numpy; fi
 command -v "$blender" > /dev/null || { echo "blender-addon-test: $blender is not installed" >&2; exit 2; }

@@ -21,15 +21,7 @@ cache="$1"
 shift
 [[ -f "$cache" ]] || { echo "blender-roundtrip: $cache: no such cache" >&2; exit 2; }
 
-crumple="${CRUMPLE_BIN:-}"
-if [[ -z "$crumple" ]]; then
-  if [[ -x "${CRUMPLE_BUILD_DIR:-$root/build}/crumple" ]]; then
-    crumple="${CRUMPLE_BUILD_DIR:-$root/build}/crumple"
-  else
-    crumple="$(command -v crumple || true)"
-  fi
-fi
-[[ -n "$crumple" && -x "$crumple" ]] || { echo "blender-roundtrip: no crumple binary (set CRUMPLE_BIN)" >&2; exit 2; }
+source "$root/scripts/crumple-bin.sh"
 blender="${BLENDER:-blender}"
 # Blender and the numpy its glTF importer needs (Debian's blender does not pull it in).
 if [[ -z "${BLENDER:-}" ]]; then bash "$root/scripts/bootstrap.sh" blender python3-numpy; fi
