@@ -12,7 +12,7 @@
 #   bash scripts/gallery.sh [SAMPLE ...]     (default: every sample)
 #
 # Environment: BUILD_DIR (default $CRUMPLE_BUILD_DIR or build/), OUT (default
-# out/gallery), CELL (cell width, default 200). Takes about 6 minutes on 2
+# out/gallery), CELL (cell width, default 200). Takes about 10 minutes on 2
 # cores for every sample (the tearing ones take longest).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
